@@ -1,0 +1,25 @@
+# Shared setup for the scripts: target directory outside the clone, one build profile,
+# and the system packages Focal needs, installed when missing.
+set -euo pipefail
+
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/focal-target}"
+export CARGO_TERM_COLOR="${CARGO_TERM_COLOR:-never}"
+
+# Debian packages needed at run time (added as the GPU renderer and the app arrive).
+FOCAL_PACKAGES=()
+
+ensure_packages() {
+  local missing=()
+  for p in "${FOCAL_PACKAGES[@]}"; do
+    dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "installing: ${missing[*]}" >&2
+  local sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo apt-get update -qq >&2
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}" >&2
+}
+
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+ensure_packages

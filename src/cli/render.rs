@@ -1,0 +1,135 @@
+//! `focal render`: a volume or phantom to PNG with the CPU reference renderer.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use focal::reference::{RenderScene, render};
+use focal::region::{Appearance, Lookup, Mode, View};
+use focal::transfer::{LabelTransfer, presets};
+use focal::volume::readers::RawSpec;
+use focal::volume::{LabelTable, LabelVolume};
+
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Volume file, DICOM folder or `phantom:head|engine|sphere` (default: the head phantom).
+    input: Option<PathBuf>,
+    /// Render on the CPU with the reference renderer (the only renderer so far).
+    #[arg(long)]
+    cpu: bool,
+    /// Transfer-function preset name or `.ron` file (default: chosen for the data).
+    #[arg(long)]
+    preset: Option<String>,
+    /// dvr, mip, minip, xray, gradient_dvr or iso.
+    #[arg(long, default_value = "dvr")]
+    mode: Mode,
+    /// View: anterior/front, posterior, left, right, superior/top, inferior, oblique.
+    #[arg(long, default_value = "oblique")]
+    view: View,
+    /// Orthographic projection instead of perspective.
+    #[arg(long)]
+    ortho: bool,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "512x512")]
+    size: String,
+    /// Sample distance in units of the smallest voxel spacing.
+    #[arg(long, default_value_t = 0.5)]
+    step: f32,
+    /// Iso-value in the data's units (iso mode; default: the middle of the value range).
+    #[arg(long)]
+    iso: Option<f64>,
+    /// Jitter ray starts (removes wood-grain rings; adds fine noise).
+    #[arg(long)]
+    jitter: bool,
+    /// Render as a label volume with the colours of its label table.
+    #[arg(long)]
+    labels: bool,
+    /// Layout of headerless raw files: DIMS:TYPE[:le|be][:s=SPACING][:skip=BYTES].
+    #[arg(long)]
+    raw: Option<RawSpec>,
+    /// Resolution of generated phantoms.
+    #[arg(long, default_value_t = 256)]
+    resolution: u32,
+    /// Output PNG.
+    #[arg(long, short, default_value = "out/render.png")]
+    out: PathBuf,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size '{s}' is not WIDTHxHEIGHT"))?;
+    let p = |v: &str| {
+        v.trim().parse::<u32>().ok().filter(|&n| (1..=8192).contains(&n)).ok_or_else(|| format!("size '{s}': {v} is not 1..8192"))
+    };
+    Ok((p(w)?, p(h)?))
+}
+
+pub fn run(args: &RenderArgs) -> Result<(), String> {
+    if !args.cpu {
+        eprintln!("note: the GPU renderer is not built yet; rendering on the CPU");
+    }
+    let (w, h) = parse_size(&args.size)?;
+    let t = Instant::now();
+    let volume = super::load(args.input.as_deref(), args.raw.as_ref(), args.resolution)?;
+    eprintln!("loaded {} ({}) in {:.2} s", volume.name, focal::volume::grid::fmt_dims(volume.dims()), t.elapsed().as_secs_f32());
+    let labels;
+    let (target, lookup) = if args.labels {
+        let table = match &args.input {
+            Some(p) => focal::volume::readers::label_table::read_sidecars(p).map_err(|e| e.to_string())?,
+            None => LabelTable::default(),
+        };
+        labels = LabelVolume::from_volume(volume, table)?;
+        let ids = labels.present_ids().into_iter().map(|(id, _)| id);
+        let lookup = Lookup::Labels(LabelTransfer::from_table(&labels.table, ids, 0.6));
+        (&labels.volume, lookup)
+    } else {
+        labels = LabelVolume { volume, table: LabelTable::default() };
+        let tf = match &args.preset {
+            Some(p) => presets::load(p)?,
+            None if args.mode.is_projection() => presets::builtin("grayscale_ramp")?,
+            None => presets::default_for(&labels.volume)?,
+        };
+        (&labels.volume, Lookup::Transfer(tf))
+    };
+    let mut appearance = Appearance { lookup, ..Appearance::new(args.mode, presets::builtin("grayscale_ramp")?) };
+    appearance.step = args.step;
+    appearance.iso_value = args.iso.unwrap_or((target.stats.min + target.stats.max) * 0.5);
+    let mut scene = RenderScene::single(target, appearance);
+    scene.jitter = args.jitter;
+    let (lo, hi) = target.grid.world_bounds();
+    let camera = args.view.frame((lo + hi) * 0.5, (hi - lo).length() * 0.5, args.ortho);
+    let t = Instant::now();
+    let image = render(&scene, &camera, w, h)?;
+    eprintln!("rendered {w}×{h} in {:.2} s", t.elapsed().as_secs_f32());
+    write(&image, &args.out)
+}
+
+fn write(image: &focal::reference::RenderedImage, out: &Path) -> Result<(), String> {
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    image.save_png(out)?;
+    println!("{}", out.display());
+    Ok(())
+}
+
+/// `focal [VOLUME]` without a window (the app comes with the GPU renderer): renders
+/// the default view of the volume, or of the head phantom, to `out`.
+pub fn run_default(volume: Option<&Path>, out: &Path) -> Result<(), String> {
+    let args = RenderArgs {
+        input: volume.map(Path::to_path_buf),
+        cpu: true,
+        preset: None,
+        mode: Mode::Dvr,
+        view: View::Oblique,
+        ortho: false,
+        size: "512x512".into(),
+        step: 0.5,
+        iso: None,
+        jitter: true,
+        labels: false,
+        raw: None,
+        resolution: 256,
+        out: out.to_path_buf(),
+    };
+    run(&args)
+}

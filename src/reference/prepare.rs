@@ -1,0 +1,127 @@
+//! Everything the per-pixel function needs about one region, computed once per render:
+//! the sampler, the baked lookup, the brick occupancy and the constants of the mode.
+
+use glam::{Mat3, Vec3};
+
+use crate::region::{Appearance, Lookup, Mode, Region, Shading};
+use crate::transfer::Lut;
+use crate::volume::sample::VolumeSampler;
+use crate::volume::{BrickGrid, Volume};
+
+/// A baked lookup.
+pub enum PreparedLookup {
+    /// Transfer-function table and the map `u = a·t + b` from normalised sample to texcoord.
+    Transfer { lut: Lut, a: f32, b: f32 },
+    /// RGBA per label id.
+    Labels(Vec<[f32; 4]>),
+}
+
+impl PreparedLookup {
+    /// RGBA of a normalised sample (transfer functions) or of a label code.
+    #[inline]
+    pub fn classify(&self, t: f32, code: u16) -> [f32; 4] {
+        match self {
+            PreparedLookup::Transfer { lut, a, b } => lut.sample(a * t + b),
+            PreparedLookup::Labels(table) => table.get(code as usize).copied().unwrap_or([0.0; 4]),
+        }
+    }
+}
+
+/// A region ready to be sampled.
+pub struct PreparedRegion<'a> {
+    pub region: &'a Region,
+    pub volume: &'a Volume,
+    pub sampler: VolumeSampler<'a>,
+    pub lookup: PreparedLookup,
+    pub mode: Mode,
+    pub shading: Shading,
+    /// Step length in the volume's own millimetres.
+    pub native_step: f32,
+    /// Reference length of transfer-function opacities (smallest voxel spacing).
+    pub reference_length: f32,
+    /// World→voxel linear part transposed: turns voxel-index gradients into world ones.
+    pub normal_matrix: Mat3,
+    /// World→native millimetres linear map (index→world of the volume after the region map).
+    pub to_native: Mat3,
+    /// Iso-value as a normalised sample.
+    pub iso: f32,
+    /// Largest gradient magnitude (normalised units per voxel), for gradient modulation.
+    pub gradient_max: f32,
+    /// Per-brick visibility (DVR modes with a transfer function): invisible bricks add
+    /// nothing and are not sampled.
+    pub occupancy: Option<(&'a BrickGrid, Vec<bool>)>,
+}
+
+impl<'a> PreparedRegion<'a> {
+    pub fn new(region: &'a Region, volume: &'a Volume, appearance: &Appearance) -> Self {
+        let labels = matches!(appearance.lookup, Lookup::Labels(_));
+        let lookup = match &appearance.lookup {
+            Lookup::Transfer(tf) => {
+                let lut = Lut::for_volume(tf, volume);
+                let (a, b) = lut.texcoord_map(volume);
+                PreparedLookup::Transfer { lut, a, b }
+            }
+            Lookup::Labels(styles) => PreparedLookup::Labels(styles.bake(volume.stats.code_max as usize + 1)),
+        };
+        // Label volumes are composited like DVR whatever the mode says.
+        let mode = if labels { Mode::Dvr } else { appearance.mode };
+        let occupancy = match (&lookup, mode) {
+            (PreparedLookup::Transfer { lut, .. }, Mode::Dvr | Mode::GradientDvr) => {
+                let bricks = volume.bricks();
+                let map = &volume.values;
+                Some((bricks, bricks.occupancy(|lo, hi| lut.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0)))
+            }
+            _ => None,
+        };
+        let a = Mat3::from(region.world_to_voxel.matrix3);
+        let index_to_native = volume.grid.direction * Mat3::from_diagonal(volume.grid.spacing);
+        let reference_length = volume.grid.min_spacing();
+        PreparedRegion {
+            region,
+            volume,
+            sampler: VolumeSampler::of(volume),
+            lookup,
+            mode,
+            shading: appearance.shading,
+            native_step: appearance.step.max(0.01) * reference_length,
+            reference_length,
+            normal_matrix: a.transpose(),
+            to_native: index_to_native * a,
+            iso: volume.real_to_normalized(appearance.iso_value) as f32,
+            gradient_max: volume.gradient_max().max(1e-6),
+            occupancy,
+        }
+    }
+
+    /// World step that advances `native_step` in the volume along `dir`.
+    pub fn world_step(&self, dir: Vec3) -> f32 {
+        let scale = (self.to_native * dir).length().max(1e-9);
+        self.native_step / scale
+    }
+
+    /// Whether the brick holding voxel position `q` can contribute (always true when
+    /// there is no occupancy).
+    #[inline]
+    pub fn occupied(&self, q: Vec3) -> bool {
+        match &self.occupancy {
+            Some((bricks, occ)) => occ[bricks.index(bricks.brick_at(q))],
+            None => true,
+        }
+    }
+
+    /// Gradient at voxel position `q` in normalised units per voxel (index axes). Label
+    /// volumes use the gradient of the label opacity field.
+    pub fn index_gradient(&self, q: Vec3) -> Vec3 {
+        match &self.lookup {
+            PreparedLookup::Labels(table) => {
+                let alpha = |p: Vec3| table.get(self.sampler.nearest(p) as usize).map(|c| c[3]).unwrap_or(0.0);
+                Vec3::new(
+                    alpha(q + Vec3::X) - alpha(q - Vec3::X),
+                    alpha(q + Vec3::Y) - alpha(q - Vec3::Y),
+                    alpha(q + Vec3::Z) - alpha(q - Vec3::Z),
+                ) * 0.5
+            }
+            PreparedLookup::Transfer { .. } => self.sampler.gradient(q),
+        }
+    }
+}

@@ -1,0 +1,288 @@
+//! The per-pixel function: one ray through every region, front to back.
+//!
+//! 1. Intersect the ray with each region: intervals `[t0, t1]` (clamped to `t ≥ 0`).
+//! 2. March one sample sequence over the union, `t_k = t_start + (k + j)·Δ`, with `Δ` the
+//!    smallest world step of the regions on the ray and `j` the jitter offset (0.5 without
+//!    jitter: the midpoint rule, so an axis-aligned ray with `Δ` = one voxel samples the
+//!    voxel centres exactly).
+//! 3. At each sample, every region whose interval contains it contributes, in region
+//!    order (overlapping regions combine sample by sample):
+//!    - DVR: `rgba = TF(f(q))`, opacity corrected for the step,
+//!      `α = 1 − (1 − α_TF)^(Δ_native/Δ₀)`, colour Blinn-Phong shaded with the gradient
+//!      normal, composited front to back `C += (1 − A)·α·c`, `A += (1 − A)·α`;
+//!    - gradient-modulated DVR: as DVR with `α ·= |∇f| / max|∇f|`;
+//!    - MIP / MinIP / X-ray: the region keeps the max / min / mean of its samples and
+//!      emits `TF(value)` as one sample when the ray leaves its interval;
+//!    - iso-surface: the first sign change of `f − iso` between samples is refined by
+//!      bisection, shaded and composited as an opaque sample.
+//! 4. Stop early once `A ≥ 0.99` (or at the pick threshold when picking).
+//!
+//! The GPU shader implements the same function; keep them in step.
+
+use glam::{Vec3, Vec4};
+
+use super::prepare::PreparedRegion;
+use crate::region::{Light, Mode, Ray, Shading};
+use crate::transfer::opacity;
+
+/// Accumulated opacity at which a ray stops.
+pub const EARLY_TERMINATION: f32 = 0.99;
+/// Bisection steps refining an iso-surface crossing (interval shrinks by 2⁻⁸).
+pub const ISO_REFINEMENT: u32 = 8;
+
+/// What one ray produced.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Traced {
+    /// Premultiplied colour and accumulated opacity.
+    pub color: Vec4,
+    /// Projected value of the first projection region (normalised), or NaN.
+    pub value: f32,
+    /// Ray parameter where the accumulated opacity first reached the depth threshold
+    /// (or the iso-surface hit), else infinity.
+    pub depth: f32,
+    /// Region that was being composited at `depth`.
+    pub region: Option<usize>,
+    /// Sample positions visited along the ray.
+    pub samples: u32,
+}
+
+/// Per-region state along the ray.
+#[derive(Clone, Copy)]
+struct State {
+    t0: f32,
+    t1: f32,
+    max: f32,
+    min: f32,
+    sum: f32,
+    count: u32,
+    prev: Option<(f32, f32)>,
+    done: bool,
+    /// Native length of one march step over the opacity reference length.
+    ratio: f32,
+}
+
+/// Traces one ray. `jitter` ∈ [0, 1) offsets the samples; `depth_threshold` is the
+/// accumulated opacity that defines the depth (and ends the ray when `stop_at_depth`).
+pub fn trace(regions: &[PreparedRegion], light: Light, ray: Ray, jitter: f32, depth_threshold: f32, stop_at_depth: bool) -> Traced {
+    let mut out = Traced { color: Vec4::ZERO, value: f32::NAN, depth: f32::INFINITY, region: None, samples: 0 };
+    let mut states: Vec<Option<State>> = Vec::with_capacity(regions.len());
+    let (mut t_start, mut t_end, mut step) = (f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY);
+    for r in regions {
+        let s = r.region.intersect(ray.origin, ray.dir).map(|(a, b)| (a.max(0.0), b)).filter(|(a, b)| a < b);
+        if let Some((t0, t1)) = s {
+            t_start = t_start.min(t0);
+            t_end = t_end.max(t1);
+            step = step.min(r.world_step(ray.dir));
+        }
+        states.push(s.map(|(t0, t1)| State {
+            t0,
+            t1,
+            max: f32::NEG_INFINITY,
+            min: f32::INFINITY,
+            sum: 0.0,
+            count: 0,
+            prev: None,
+            done: false,
+            ratio: 0.0,
+        }));
+    }
+    if !t_start.is_finite() {
+        return out;
+    }
+    for (st, r) in states.iter_mut().zip(regions) {
+        if let Some(st) = st {
+            st.ratio = r.native_step * (step / r.world_step(ray.dir)) / r.reference_length;
+        }
+    }
+    let view = ray.dir;
+    let stop = if stop_at_depth { depth_threshold } else { EARLY_TERMINATION };
+    let mut k = 0u32;
+    loop {
+        let t = t_start + (k as f32 + jitter) * step;
+        if t > t_end {
+            break;
+        }
+        k += 1;
+        out.samples = k;
+        let p = ray.at(t);
+        for (i, r) in regions.iter().enumerate() {
+            let Some(st) = states[i].as_mut() else { continue };
+            if st.done {
+                continue;
+            }
+            if t > st.t1 {
+                // Left this region: a projection emits its value now.
+                if r.mode.is_projection() && st.count > 0 {
+                    let v = projected(r.mode, st);
+                    emit_projection(&mut out, r, v, t, i, depth_threshold);
+                }
+                st.done = true;
+                continue;
+            }
+            if t < st.t0 {
+                continue;
+            }
+            let q = r.region.world_to_voxel.transform_point3(p);
+            match r.mode {
+                Mode::Mip | Mode::MinIp | Mode::XRay => {
+                    let v = r.sampler.trilinear(q);
+                    st.max = st.max.max(v);
+                    st.min = st.min.min(v);
+                    st.sum += v;
+                    st.count += 1;
+                }
+                Mode::Dvr | Mode::GradientDvr => {
+                    if !r.occupied(q) {
+                        continue;
+                    }
+                    let v = r.sampler.trilinear(q);
+                    let rgba = r.lookup.classify(v, r.sampler.nearest(q));
+                    if rgba[3] <= 0.0 {
+                        continue;
+                    }
+                    let mut alpha = opacity::correct(rgba[3], st.ratio);
+                    let g = r.index_gradient(q);
+                    if r.mode == Mode::GradientDvr {
+                        alpha *= (g.length() / r.gradient_max).min(1.0);
+                    }
+                    let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), r.normal_matrix * g, view, light, &r.shading);
+                    composite(&mut out, c, alpha, t, i, depth_threshold);
+                }
+                Mode::Iso => {
+                    let v = r.sampler.trilinear(q) - r.iso;
+                    if let Some((tp, vp)) = st.prev
+                        && (vp < 0.0) != (v < 0.0)
+                    {
+                        let th = refine(r, &ray, (tp, vp), (t, v));
+                        let qh = r.region.world_to_voxel.transform_point3(ray.at(th));
+                        let rgba = r.lookup.classify(r.iso, r.sampler.nearest(qh));
+                        let g = r.index_gradient(qh);
+                        let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), r.normal_matrix * g, view, light, &r.shading);
+                        composite(&mut out, c, 1.0, th, i, depth_threshold);
+                        st.done = true;
+                    } else {
+                        st.prev = Some((t, v));
+                    }
+                }
+            }
+        }
+        if out.color.w >= stop {
+            break;
+        }
+    }
+    // Projections still open at the end of the march.
+    for (i, r) in regions.iter().enumerate() {
+        if let Some(st) = states[i]
+            && !st.done
+            && r.mode.is_projection()
+            && st.count > 0
+            && out.color.w < stop
+        {
+            emit_projection(&mut out, r, projected(r.mode, &st), st.t1, i, depth_threshold);
+        }
+    }
+    out
+}
+
+fn projected(mode: Mode, st: &State) -> f32 {
+    match mode {
+        Mode::Mip => st.max,
+        Mode::MinIp => st.min,
+        _ => st.sum / st.count as f32,
+    }
+}
+
+fn emit_projection(out: &mut Traced, r: &PreparedRegion, v: f32, t: f32, i: usize, threshold: f32) {
+    if out.value.is_nan() {
+        out.value = v;
+    }
+    let rgba = r.lookup.classify(v, 0);
+    composite(out, Vec3::new(rgba[0], rgba[1], rgba[2]), rgba[3], t, i, threshold);
+}
+
+/// Front-to-back "under" compositing of a non-premultiplied colour with opacity `alpha`.
+#[inline]
+fn composite(out: &mut Traced, c: Vec3, alpha: f32, t: f32, region: usize, threshold: f32) {
+    let w = (1.0 - out.color.w) * alpha;
+    out.color += Vec4::new(c.x * w, c.y * w, c.z * w, w);
+    if out.color.w >= threshold && out.depth.is_infinite() {
+        out.depth = t;
+        out.region = Some(region);
+    }
+}
+
+/// Bisection between two samples on either side of the iso-value.
+fn refine(r: &PreparedRegion, ray: &Ray, (mut ta, va): (f32, f32), (mut tb, _): (f32, f32)) -> f32 {
+    let below = va < 0.0;
+    for _ in 0..ISO_REFINEMENT {
+        let tm = 0.5 * (ta + tb);
+        let v = r.sampler.trilinear(r.region.world_to_voxel.transform_point3(ray.at(tm))) - r.iso;
+        if (v < 0.0) == below {
+            ta = tm;
+        } else {
+            tb = tm;
+        }
+    }
+    0.5 * (ta + tb)
+}
+
+/// Blinn-Phong shading of colour `c` with the (unnormalised) world gradient `g`, seen
+/// along the ray direction `view`. Two-sided: the normal is turned towards the viewer.
+/// A vanishing gradient (no surface) leaves the colour unshaded.
+pub fn shade(c: Vec3, g: Vec3, view: Vec3, light: Light, s: &Shading) -> Vec3 {
+    let len = g.length();
+    if !s.enabled || len < 1e-6 {
+        return c;
+    }
+    let v = -view;
+    let mut n = g / len;
+    if n.dot(v) < 0.0 {
+        n = -n;
+    }
+    let l = match light {
+        Light::Headlight => v,
+        Light::Direction(d) => d.normalize_or(v),
+    };
+    let h = (l + v).normalize_or(v);
+    let lit = c * (s.ambient + s.diffuse * n.dot(l).max(0.0)) + Vec3::splat(s.specular * n.dot(h).max(0.0).powf(s.shininess));
+    lit.clamp(Vec3::ZERO, Vec3::ONE)
+}
+
+/// Deterministic per-pixel jitter in `[0, 1)` (the same integer hash as the shader).
+pub fn jitter(x: u32, y: u32, frame: u32) -> f32 {
+    let mut h = x.wrapping_mul(1_973).wrapping_add(y.wrapping_mul(9_277)).wrapping_add(frame.wrapping_mul(26_699)) | 1;
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7feb_352d);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846c_a68b);
+    h ^= h >> 16;
+    (h >> 8) as f32 / (1u32 << 24) as f32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blinn_phong_matches_hand_values() {
+        let s = Shading { enabled: true, ambient: 0.2, diffuse: 0.5, specular: 0.3, shininess: 2.0 };
+        // Head-on surface: N·L = N·H = 1 → c·0.7 + 0.3.
+        let c = shade(Vec3::splat(0.5), Vec3::Z, Vec3::NEG_Z, Light::Headlight, &s);
+        assert!((c - Vec3::splat(0.65)).length() < 1e-6);
+        // Light from 60° off the normal, viewer head-on: N·L = 0.5, H at 30°, N·H = cos 30°.
+        let l = Vec3::new(3f32.sqrt() / 2.0, 0.0, 0.5);
+        let c = shade(Vec3::ONE, -Vec3::Z * 3.0, Vec3::NEG_Z, Light::Direction(l), &s);
+        let expect = 0.2 + 0.5 * 0.5 + 0.3 * (30f32.to_radians().cos()).powi(2);
+        assert!((c.x - expect).abs() < 1e-5, "{} vs {expect}", c.x);
+        // No gradient: unshaded.
+        assert_eq!(shade(Vec3::splat(0.4), Vec3::ZERO, Vec3::NEG_Z, Light::Headlight, &s), Vec3::splat(0.4));
+    }
+
+    #[test]
+    fn jitter_is_uniform_enough() {
+        let n = 10_000;
+        let mean: f32 = (0..n).map(|i| jitter(i % 100, i / 100, 0)).sum::<f32>() / n as f32;
+        assert!((mean - 0.5).abs() < 0.02, "{mean}");
+        assert!((0..n).all(|i| (0.0..1.0).contains(&jitter(i, 7, 3))));
+    }
+}

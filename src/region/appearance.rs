@@ -1,0 +1,109 @@
+//! How a region looks: rendering mode, lookup (transfer function or label styles),
+//! shading and sampling step. Shared by the CPU reference and the GPU renderer.
+
+use serde::{Deserialize, Serialize};
+
+use crate::transfer::{LabelTransfer, TransferFunction};
+
+/// Rendering modes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Direct volume rendering, front-to-back compositing with Blinn-Phong shading.
+    #[default]
+    Dvr,
+    /// Maximum intensity projection.
+    Mip,
+    /// Minimum intensity projection.
+    MinIp,
+    /// Average along the ray (a simulated radiograph).
+    XRay,
+    /// DVR with opacity scaled by the normalised gradient magnitude.
+    GradientDvr,
+    /// First hit of an iso-value, shaded.
+    Iso,
+}
+
+impl Mode {
+    pub const ALL: [Mode; 6] = [Mode::Dvr, Mode::Mip, Mode::MinIp, Mode::XRay, Mode::GradientDvr, Mode::Iso];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Dvr => "dvr",
+            Mode::Mip => "mip",
+            Mode::MinIp => "minip",
+            Mode::XRay => "xray",
+            Mode::GradientDvr => "gradient_dvr",
+            Mode::Iso => "iso",
+        }
+    }
+
+    /// Whether the mode projects one value per region instead of compositing samples.
+    pub fn is_projection(self) -> bool {
+        matches!(self, Mode::Mip | Mode::MinIp | Mode::XRay)
+    }
+}
+
+impl std::str::FromStr for Mode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let s = s.trim().to_ascii_lowercase().replace('-', "_");
+        Mode::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown mode '{s}' (dvr, mip, minip, xray, gradient_dvr, iso)"))
+    }
+}
+
+/// Blinn-Phong coefficients: `c·(ka + kd·max(N·L, 0)) + ks·max(N·H, 0)^shininess`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Shading {
+    pub enabled: bool,
+    pub ambient: f32,
+    pub diffuse: f32,
+    pub specular: f32,
+    pub shininess: f32,
+}
+
+impl Default for Shading {
+    fn default() -> Self {
+        Self { enabled: true, ambient: 0.3, diffuse: 0.7, specular: 0.25, shininess: 24.0 }
+    }
+}
+
+/// Where the light comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum Light {
+    /// From the eye, along each ray.
+    #[default]
+    Headlight,
+    /// A fixed world-space direction *towards* the light.
+    Direction(glam::Vec3),
+}
+
+/// What a sample's value is looked up in.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Lookup {
+    /// A transfer function (baked for the region's volume when rendering).
+    Transfer(TransferFunction),
+    /// Per-label styles of a label volume (nearest sampling).
+    Labels(LabelTransfer),
+}
+
+/// The appearance of a region.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Appearance {
+    pub mode: Mode,
+    pub lookup: Lookup,
+    pub shading: Shading,
+    /// Distance between samples in units of the volume's smallest voxel spacing.
+    pub step: f32,
+    /// Iso-value in real units (for [`Mode::Iso`]).
+    pub iso_value: f64,
+}
+
+impl Appearance {
+    pub fn new(mode: Mode, tf: TransferFunction) -> Self {
+        Self { mode, lookup: Lookup::Transfer(tf), shading: Shading::default(), step: 0.5, iso_value: 0.0 }
+    }
+}

@@ -1,0 +1,159 @@
+//! Regions: the one rendering idea of Focal (see DESIGN.md, "One rendering idea").
+//!
+//! Everything that shows volume data is a [`Region`]: a convex polyhedron in world space
+//! (a list of [`Plane`]s), an affine map from world space to the continuous voxel index
+//! of one volume, and the index of an [`Appearance`]. A dataset on its own is one region
+//! (its box, cut by clip planes); volumetric windows and exploded parts add regions with
+//! other maps. The per-pixel function intersects the ray with every region, giving
+//! intervals, and walks them front to back. This module holds the pure geometry, shared
+//! by the CPU reference renderer, the GPU packing and the techniques that make regions.
+
+pub mod appearance;
+pub mod camera;
+
+use glam::{Affine3A, Vec3};
+
+pub use appearance::{Appearance, Light, Lookup, Mode, Shading};
+pub use camera::{Camera, Projection, Ray, View};
+
+use crate::volume::Grid;
+
+/// A half-space: points `p` with `normal · p ≤ offset` are inside.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plane {
+    pub normal: Vec3,
+    pub offset: f32,
+}
+
+impl Plane {
+    /// The half-space `normal · p ≤ normal · point` (normal pointing out of the region).
+    pub fn through(point: Vec3, normal: Vec3) -> Plane {
+        let n = normal.normalize_or_zero();
+        Plane { normal: n, offset: n.dot(point) }
+    }
+
+    /// Signed distance of `p` outside the half-space (negative inside).
+    pub fn distance(&self, p: Vec3) -> f32 {
+        self.normal.dot(p) - self.offset
+    }
+
+    /// The same boundary with the other side inside.
+    pub fn flipped(&self) -> Plane {
+        Plane { normal: -self.normal, offset: -self.offset }
+    }
+}
+
+/// A convex region of space showing one volume through an affine map.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Region {
+    pub planes: Vec<Plane>,
+    /// World position → continuous voxel index of the volume.
+    pub world_to_voxel: Affine3A,
+    /// Index of the volume in the scene.
+    pub volume: usize,
+    /// Index of the appearance in the scene.
+    pub appearance: usize,
+}
+
+impl Region {
+    /// The box of a volume's voxel cells, showing that volume in place.
+    pub fn volume_box(grid: &Grid, volume: usize, appearance: usize) -> Region {
+        let world_to_voxel = grid.world_to_index();
+        Region { planes: box_planes(&world_to_voxel, Vec3::splat(-0.5), grid.dims.as_vec3() - 0.5), world_to_voxel, volume, appearance }
+    }
+
+    /// Adds a cutting plane (keeps the part with `normal · p ≤ offset`).
+    pub fn clipped(mut self, plane: Plane) -> Region {
+        self.planes.push(plane);
+        self
+    }
+
+    /// Whether a world point lies inside (on the boundary counts as inside).
+    pub fn contains(&self, p: Vec3) -> bool {
+        self.planes.iter().all(|pl| pl.distance(p) <= 1e-5)
+    }
+
+    /// The parameter interval `[t0, t1]` of `origin + t·dir` inside the region, if any.
+    pub fn intersect(&self, origin: Vec3, dir: Vec3) -> Option<(f32, f32)> {
+        ray_convex(&self.planes, origin, dir)
+    }
+}
+
+/// Clips a ray against a convex set of half-spaces (Cyrus–Beck / Kay–Kajiya slabs):
+/// each plane with `n·d < 0` can only raise the entry, `n·d > 0` only lowers the exit, and
+/// a ray parallel to a plane is either wholly inside or wholly outside it.
+pub fn ray_convex(planes: &[Plane], origin: Vec3, dir: Vec3) -> Option<(f32, f32)> {
+    let (mut t0, mut t1) = (f32::NEG_INFINITY, f32::INFINITY);
+    for p in planes {
+        let denom = p.normal.dot(dir);
+        let dist = p.offset - p.normal.dot(origin);
+        if denom.abs() < 1e-12 {
+            if dist < 0.0 {
+                return None;
+            }
+            continue;
+        }
+        let t = dist / denom;
+        if denom < 0.0 {
+            t0 = t0.max(t);
+        } else {
+            t1 = t1.min(t);
+        }
+        if t0 > t1 {
+            return None;
+        }
+    }
+    (t0 <= t1).then_some((t0, t1))
+}
+
+/// World planes of the index-space box `[lo, hi]` under `world_to_index`
+/// (`q = A·p + t`): the index plane `m·q ≤ c` is the world plane `(Aᵀm)·p ≤ c − m·t`.
+pub fn box_planes(world_to_index: &Affine3A, lo: Vec3, hi: Vec3) -> Vec<Plane> {
+    let a = glam::Mat3::from(world_to_index.matrix3);
+    let t = Vec3::from(world_to_index.translation);
+    let mut planes = Vec::with_capacity(6);
+    for axis in 0..3 {
+        let e = Vec3::AXES[axis];
+        for (m, c) in [(e, hi[axis]), (-e, -lo[axis])] {
+            let n = a.transpose() * m;
+            let len = n.length();
+            planes.push(Plane { normal: n / len, offset: (c - m.dot(t)) / len });
+        }
+    }
+    planes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Mat3, UVec3};
+
+    #[test]
+    fn ray_box_entry_and_exit() {
+        let g = Grid::new(UVec3::new(10, 10, 10), Vec3::splat(2.0)); // box from −1 to 19 mm
+        let r = Region::volume_box(&g, 0, 0);
+        let (t0, t1) = r.intersect(Vec3::new(-11.0, 5.0, 5.0), Vec3::X).unwrap();
+        assert!((t0 - 10.0).abs() < 1e-5 && (t1 - 30.0).abs() < 1e-5, "{t0} {t1}");
+        assert!(r.intersect(Vec3::new(-11.0, 25.0, 5.0), Vec3::X).is_none());
+        // Parallel ray outside a slab misses; inside it hits.
+        assert!(r.intersect(Vec3::new(5.0, -5.0, 5.0), Vec3::Z).is_none());
+        assert!(r.contains(Vec3::new(0.0, 0.0, 0.0)));
+        assert!(!r.contains(Vec3::new(-1.5, 0.0, 0.0)));
+    }
+
+    #[test]
+    fn oblique_boxes_and_clip_planes() {
+        // Box rotated 90° about z: index x runs along world y.
+        let axes = Mat3::from_cols(Vec3::Y, -Vec3::X, Vec3::Z);
+        let g = Grid::from_axes(UVec3::new(4, 2, 2), axes, Vec3::ZERO).unwrap();
+        let r = Region::volume_box(&g, 0, 0);
+        // Along world y the box spans index x from −0.5 to 3.5.
+        let (t0, t1) = r.intersect(Vec3::new(0.0, -10.0, 0.5), Vec3::Y).unwrap();
+        assert!((t0 - 9.5).abs() < 1e-5 && (t1 - 13.5).abs() < 1e-5, "{t0} {t1}");
+        // Clip away y > 1.
+        let c = r.clipped(Plane::through(Vec3::new(0.0, 1.0, 0.0), Vec3::Y));
+        let (_, t1) = c.intersect(Vec3::new(0.0, -10.0, 0.5), Vec3::Y).unwrap();
+        assert!((t1 - 11.0).abs() < 1e-5);
+        assert_eq!(Plane::through(Vec3::ONE, Vec3::X).flipped().distance(Vec3::ZERO), 1.0);
+    }
+}

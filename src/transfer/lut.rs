@@ -1,0 +1,141 @@
+//! Baking a transfer function into a lookup table, and reading it back as a linearly
+//! filtered 1D texture does.
+//!
+//! The table has `N` RGBA entries over the real-value domain `[lo, hi]` (the volume's
+//! value range); entry `i` holds the function at the texel centre
+//! `lo + (i + 0.5)/N · (hi − lo)`. A lookup at texture coordinate `u` interpolates
+//! between the texels around `u·N − 0.5`, clamped at the ends, exactly like a GPU's
+//! linear filtering with clamp-to-edge. The shader gets the texture coordinate of a
+//! normalised volume sample `t` from one affine map `u = a·t + b` ([`Lut::texcoord_map`]).
+
+use super::function::TransferFunction;
+use crate::volume::Volume;
+
+/// Number of entries used for 8-bit volumes (one per code) and for 16-bit volumes.
+pub const LUT_SIZE_8: usize = 256;
+pub const LUT_SIZE_16: usize = 4096;
+
+/// A baked RGBA table (colour not premultiplied; alpha per reference length).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lut {
+    pub rgba: Vec<[f32; 4]>,
+    /// Real values at the start of the first texel and the end of the last.
+    pub lo: f64,
+    pub hi: f64,
+}
+
+impl Lut {
+    /// Bakes `tf` (already resolved to absolute values) over `[lo, hi]` with `n` entries.
+    pub fn bake(tf: &TransferFunction, lo: f64, hi: f64, n: usize) -> Lut {
+        let n = n.max(2);
+        let hi = if hi > lo { hi } else { lo + 1.0 };
+        let rgba = (0..n)
+            .map(|i| {
+                let v = lo + (i as f64 + 0.5) / n as f64 * (hi - lo);
+                let c = tf.color_at(v);
+                [c[0], c[1], c[2], tf.opacity_at(v)]
+            })
+            .collect();
+        Lut { rgba, lo, hi }
+    }
+
+    /// Bakes `tf` for a volume: relative points resolved to its range, one texel per code
+    /// for 8-bit data, [`LUT_SIZE_16`] texels over the value range otherwise.
+    pub fn for_volume(tf: &TransferFunction, volume: &Volume) -> Lut {
+        let (lo, hi) = (volume.stats.min, volume.stats.max);
+        let tf = tf.resolved(lo, hi);
+        if volume.voxels.bits() == 8 {
+            // Texel centres on the codes 0..255: domain spans code −0.5 … 255.5.
+            let a = volume.values.to_real(-0.5);
+            let b = volume.values.to_real(255.5);
+            Lut::bake(&tf, a.min(b), a.max(b), LUT_SIZE_8)
+        } else {
+            let pad = (hi - lo).abs().max(1e-9) * 0.5 / LUT_SIZE_16 as f64;
+            Lut::bake(&tf, lo - pad, hi + pad, LUT_SIZE_16)
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.rgba.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.rgba.is_empty()
+    }
+
+    /// Texture coordinate of a real value.
+    #[inline]
+    pub fn texcoord(&self, real: f64) -> f32 {
+        ((real - self.lo) / (self.hi - self.lo)) as f32
+    }
+
+    /// `(a, b)` with `u = a·t + b` mapping a normalised sample `t` of `volume` to the
+    /// texture coordinate of this table.
+    pub fn texcoord_map(&self, volume: &Volume) -> (f32, f32) {
+        let code_max = volume.code_max() as f64;
+        let span = self.hi - self.lo;
+        let a = code_max * volume.values.slope / span;
+        let b = (volume.values.intercept - self.lo) / span;
+        (a as f32, b as f32)
+    }
+
+    /// Linearly filtered lookup at texture coordinate `u` (clamp to edge).
+    #[inline]
+    pub fn sample(&self, u: f32) -> [f32; 4] {
+        let n = self.rgba.len();
+        let x = (u * n as f32 - 0.5).clamp(0.0, (n - 1) as f32);
+        let i = (x as usize).min(n - 2);
+        let t = x - i as f32;
+        let (a, b) = (self.rgba[i], self.rgba[i + 1]);
+        std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t)
+    }
+
+    /// Largest opacity of any texel that a sample between the real values `lo..=hi` can
+    /// touch (for empty-space skipping: zero means the range is invisible).
+    pub fn max_opacity_between(&self, lo: f64, hi: f64) -> f32 {
+        let n = self.rgba.len();
+        let texel = |v: f64| (self.texcoord(v) * n as f32 - 0.5).clamp(0.0, (n - 1) as f32);
+        let (a, b) = (texel(lo.min(hi)), texel(lo.max(hi)));
+        let (i0, i1) = (a.floor() as usize, (b.ceil() as usize).min(n - 1));
+        self.rgba[i0..=i1].iter().map(|c| c[3]).fold(0.0, f32::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::transfer::function::{ColorPoint, OpacityPoint, ValueSpace};
+
+    fn ramp() -> TransferFunction {
+        TransferFunction {
+            name: "ramp".into(),
+            space: ValueSpace::Absolute,
+            units: None,
+            color: vec![ColorPoint(0.0, [0.0; 3]), ColorPoint(100.0, [1.0; 3])],
+            opacity: vec![OpacityPoint(0.0, 0.0), OpacityPoint(100.0, 1.0)],
+        }
+    }
+
+    #[test]
+    fn texel_centres_hold_the_function() {
+        let lut = Lut::bake(&ramp(), 0.0, 100.0, 4);
+        // Texel centres at 12.5, 37.5, 62.5, 87.5.
+        assert_eq!(lut.rgba[1][3], 0.375);
+        // A linear function is reproduced exactly between texel centres …
+        assert!((lut.sample(lut.texcoord(50.0))[3] - 0.5).abs() < 1e-6);
+        // … and clamps outside them.
+        assert_eq!(lut.sample(0.0)[3], 0.125);
+        assert_eq!(lut.sample(1.0)[3], 0.875);
+    }
+
+    #[test]
+    fn opacity_bound_over_a_range() {
+        let mut tf = ramp();
+        tf.opacity = vec![OpacityPoint(0.0, 0.0), OpacityPoint(60.0, 0.0), OpacityPoint(61.0, 0.8)];
+        let lut = Lut::bake(&tf, 0.0, 100.0, 100);
+        assert_eq!(lut.max_opacity_between(0.0, 50.0), 0.0);
+        assert!(lut.max_opacity_between(50.0, 70.0) > 0.7);
+        // Reversed bounds work too.
+        assert!(lut.max_opacity_between(70.0, 50.0) > 0.7);
+    }
+}

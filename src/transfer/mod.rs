@@ -1,0 +1,13 @@
+//! Transfer functions: piecewise-linear colour and opacity over real values, presets
+//! from `assets/transfer/`, baked lookup tables, opacity correction for the step size,
+//! and per-label styles for label volumes.
+
+pub mod function;
+pub mod labels;
+pub mod lut;
+pub mod opacity;
+pub mod presets;
+
+pub use function::{ColorPoint, OpacityPoint, TransferFunction, ValueSpace};
+pub use labels::{LabelStyle, LabelTransfer};
+pub use lut::Lut;

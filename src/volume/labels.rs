@@ -1,0 +1,156 @@
+//! Label volumes: integer ids per voxel with a table of names and colours.
+//!
+//! A label volume is a [`Volume`] whose codes *are* the label ids (identity value map,
+//! nearest-neighbour sampling). The [`LabelTable`] names the ids and gives each a colour;
+//! ids missing from the table get a distinct generated colour so nothing is invisible by
+//! accident. Tables are read by [`crate::volume::readers::label_table`].
+
+use std::collections::BTreeMap;
+
+use super::{Source, ValueMap, Volume, Voxels};
+
+/// One entry of a label table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Label {
+    pub name: String,
+    pub color: [u8; 3],
+}
+
+/// Names and colours of label ids.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LabelTable {
+    pub labels: BTreeMap<u32, Label>,
+}
+
+impl LabelTable {
+    pub fn len(&self) -> usize {
+        self.labels.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.labels.is_empty()
+    }
+
+    pub fn get(&self, id: u32) -> Option<&Label> {
+        self.labels.get(&id)
+    }
+
+    /// Name of an id (`"label 17"` when unnamed, `"background"` for 0 when unnamed).
+    pub fn name(&self, id: u32) -> String {
+        match self.labels.get(&id) {
+            Some(l) => l.name.clone(),
+            None if id == 0 => "background".into(),
+            None => format!("label {id}"),
+        }
+    }
+
+    /// Colour of an id: the table's, else a generated one.
+    pub fn color(&self, id: u32) -> [u8; 3] {
+        self.labels.get(&id).map(|l| l.color).unwrap_or_else(|| generated_color(id))
+    }
+
+    /// Merges `other` into `self`: its names replace generated ones, its colours apply
+    /// where given. Used to combine a names file with a colour file.
+    pub fn merge(&mut self, other: LabelTable) {
+        for (id, l) in other.labels {
+            self.labels.insert(id, l);
+        }
+    }
+}
+
+/// A distinct colour for an id (golden-angle hue walk, fixed saturation and value).
+pub fn generated_color(id: u32) -> [u8; 3] {
+    if id == 0 {
+        return [0, 0, 0];
+    }
+    let h = (id as f32 * 137.507_77).rem_euclid(360.0) / 60.0;
+    let (s, v) = (0.65f32, 0.95f32);
+    let c = v * s;
+    let x = c * (1.0 - (h.rem_euclid(2.0) - 1.0).abs());
+    let (r, g, b) = match h as u32 {
+        0 => (c, x, 0.0),
+        1 => (x, c, 0.0),
+        2 => (0.0, c, x),
+        3 => (0.0, x, c),
+        4 => (x, 0.0, c),
+        _ => (c, 0.0, x),
+    };
+    let m = v - c;
+    [((r + m) * 255.0) as u8, ((g + m) * 255.0) as u8, ((b + m) * 255.0) as u8]
+}
+
+/// A volume of label ids with their table.
+#[derive(Clone, Debug)]
+pub struct LabelVolume {
+    pub volume: Volume,
+    pub table: LabelTable,
+}
+
+impl LabelVolume {
+    /// Reinterprets a read volume as labels: every real value must be a whole number in
+    /// `0..=65535`; codes become the ids themselves (8-bit when ids fit).
+    pub fn from_volume(volume: Volume, table: LabelTable) -> Result<LabelVolume, String> {
+        let counts = super::stats::code_counts(&volume.voxels);
+        let mut max_id = 0u32;
+        for (code, _) in counts.iter().enumerate().filter(|(_, c)| **c > 0) {
+            let real = volume.values.to_real(code as f64);
+            if real.fract() != 0.0 || !(0.0..=65535.0).contains(&real) {
+                return Err(format!("value {real} is not a label id (whole number 0..65535)"));
+            }
+            max_id = max_id.max(real as u32);
+        }
+        let id_of = |c: u16| volume.values.to_real(c as f64) as u32;
+        let voxels = match (&volume.voxels, max_id <= 255) {
+            (Voxels::U8(v), true) if volume.values == ValueMap::IDENTITY => Voxels::U8(v.clone()),
+            (v, true) => Voxels::U8((0..v.len()).map(|i| id_of(v.code(i)) as u8).collect()),
+            (v, false) => Voxels::U16((0..v.len()).map(|i| id_of(v.code(i)) as u16).collect()),
+        };
+        let source = Source { format: volume.source.format.clone(), ..volume.source.clone() };
+        let volume = Volume::new(volume.name.clone(), volume.grid.clone(), voxels, ValueMap::IDENTITY, source)?;
+        Ok(LabelVolume { volume, table })
+    }
+
+    /// Ids present in the volume (with voxel counts), background 0 included.
+    pub fn present_ids(&self) -> Vec<(u32, u64)> {
+        super::stats::code_counts(&self.volume.voxels)
+            .into_iter()
+            .enumerate()
+            .filter(|(_, c)| *c > 0)
+            .map(|(id, c)| (id as u32, c))
+            .collect()
+    }
+
+    /// Label id of voxel (i, j, k).
+    pub fn id(&self, i: u32, j: u32, k: u32) -> u32 {
+        self.volume.code(i, j, k) as u32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::volume::Grid;
+    use glam::{UVec3, Vec3};
+
+    #[test]
+    fn generated_colours_differ_and_background_is_black() {
+        assert_eq!(generated_color(0), [0, 0, 0]);
+        let a = generated_color(1);
+        let b = generated_color(2);
+        assert_ne!(a, b);
+    }
+
+    #[test]
+    fn from_volume_requires_whole_ids() {
+        let grid = Grid::new(UVec3::new(3, 1, 1), Vec3::ONE);
+        let v = Volume::new("l", grid.clone(), Voxels::U16(vec![0, 5, 300]), ValueMap::IDENTITY, Source::default()).unwrap();
+        let l = LabelVolume::from_volume(v, LabelTable::default()).unwrap();
+        assert_eq!(l.present_ids(), vec![(0, 1), (5, 1), (300, 1)]);
+        let shifted = Volume::new("l", grid.clone(), Voxels::U16(vec![0, 1, 2]), ValueMap::new(1.0, 10.0), Source::default()).unwrap();
+        let l = LabelVolume::from_volume(shifted, LabelTable::default()).unwrap();
+        assert!(matches!(l.volume.voxels, Voxels::U8(_)));
+        assert_eq!(l.id(2, 0, 0), 12);
+        let frac = Volume::new("l", grid, Voxels::U16(vec![0, 1, 2]), ValueMap::new(0.5, 0.0), Source::default()).unwrap();
+        assert!(LabelVolume::from_volume(frac, LabelTable::default()).is_err());
+    }
+}

@@ -1,0 +1,138 @@
+//! Volume data: the grid model, readers, phantoms, label and selection volumes.
+//!
+//! A [`Volume`] is a regular grid ([`Grid`]: dimensions, spacing, origin, orientation)
+//! of compact voxel codes ([`Voxels`], 8 or 16 bit) with a [`ValueMap`] back to real
+//! values, its [`ValueStats`] (range, histogram) and the [`BrickGrid`] of per-brick code
+//! ranges used for empty-space skipping. Label volumes ([`LabelVolume`]) and selection
+//! volumes ([`SelectionVolume`], degree of interest 0..1) are volumes too.
+
+pub mod bricks;
+pub mod encode;
+pub mod grid;
+pub mod labels;
+pub mod phantom;
+pub mod readers;
+pub mod sample;
+pub mod selection;
+pub mod stats;
+pub mod voxels;
+
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+use glam::UVec3;
+
+pub use bricks::{BrickGrid, DEFAULT_BRICK_SIZE};
+pub use encode::{ByteOrder, SampleType};
+pub use grid::Grid;
+pub use labels::{Label, LabelTable, LabelVolume};
+pub use selection::SelectionVolume;
+pub use stats::{Histogram, ValueStats};
+pub use voxels::{ValueMap, Voxels};
+
+/// Where a volume came from.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Source {
+    /// Format name (`NIfTI-1`, `DICOM series`, `phantom`, …).
+    pub format: String,
+    /// File or folder it was read from.
+    pub path: Option<PathBuf>,
+    /// Sample type in the file (`uint8`, `int16`, `float32`, …).
+    pub sample_type: String,
+    /// Further facts worth showing (`key`, `value`), e.g. the DICOM modality.
+    pub details: Vec<(String, String)>,
+}
+
+/// A scalar volume.
+#[derive(Debug)]
+pub struct Volume {
+    pub name: String,
+    pub grid: Grid,
+    pub voxels: Voxels,
+    pub values: ValueMap,
+    pub stats: ValueStats,
+    pub source: Source,
+    bricks: OnceLock<BrickGrid>,
+    gradient_max: OnceLock<f32>,
+}
+
+impl Clone for Volume {
+    fn clone(&self) -> Self {
+        Self {
+            name: self.name.clone(),
+            grid: self.grid.clone(),
+            voxels: self.voxels.clone(),
+            values: self.values.clone(),
+            stats: self.stats.clone(),
+            source: self.source.clone(),
+            bricks: self.bricks.clone(),
+            gradient_max: self.gradient_max.clone(),
+        }
+    }
+}
+
+impl Volume {
+    /// Builds a volume, checking that the voxel count matches the grid.
+    pub fn new(name: impl Into<String>, grid: Grid, voxels: Voxels, values: ValueMap, source: Source) -> Result<Volume, String> {
+        grid.validate()?;
+        if voxels.len() != grid.voxel_count() {
+            return Err(format!(
+                "{} voxels do not fill a {} grid ({} voxels)",
+                voxels.len(),
+                grid::fmt_dims(grid.dims),
+                grid.voxel_count()
+            ));
+        }
+        if !(values.slope.is_finite() && values.intercept.is_finite()) || values.slope == 0.0 {
+            return Err(format!("value rescale {}·v + {} is not usable", values.slope, values.intercept));
+        }
+        let stats = stats::compute(&voxels, &values);
+        Ok(Volume { name: name.into(), grid, voxels, values, stats, source, bricks: OnceLock::new(), gradient_max: OnceLock::new() })
+    }
+
+    pub fn dims(&self) -> UVec3 {
+        self.grid.dims
+    }
+
+    /// Code of voxel (i, j, k).
+    #[inline]
+    pub fn code(&self, i: u32, j: u32, k: u32) -> u16 {
+        self.voxels.code(self.grid.linear_index(i, j, k))
+    }
+
+    /// Real value of voxel (i, j, k).
+    pub fn real(&self, i: u32, j: u32, k: u32) -> f64 {
+        self.values.to_real(self.code(i, j, k) as f64)
+    }
+
+    /// Largest code of the storage type (normalisation denominator).
+    pub fn code_max(&self) -> u32 {
+        self.voxels.code_max()
+    }
+
+    /// Real value of a normalised texture value `t = code / code_max`.
+    pub fn normalized_to_real(&self, t: f64) -> f64 {
+        self.values.to_real(t * self.code_max() as f64)
+    }
+
+    /// Normalised texture value of a real value.
+    pub fn real_to_normalized(&self, real: f64) -> f64 {
+        self.values.to_code(real) / self.code_max() as f64
+    }
+
+    /// The brick min-max grid (built on first use, [`DEFAULT_BRICK_SIZE`]).
+    pub fn bricks(&self) -> &BrickGrid {
+        self.bricks.get_or_init(|| BrickGrid::build(&self.voxels, self.grid.dims, DEFAULT_BRICK_SIZE))
+    }
+
+    /// Largest central-difference gradient magnitude in normalised units per voxel,
+    /// the denominator of normalised gradient magnitude (computed on first use).
+    pub fn gradient_max(&self) -> f32 {
+        *self.gradient_max.get_or_init(|| sample::max_gradient_magnitude(self))
+    }
+
+    /// Approximate memory used by the voxels.
+    pub fn byte_len(&self) -> usize {
+        self.voxels.byte_len()
+    }
+}

@@ -1,0 +1,292 @@
+//! Assembling DICOM slices or frames into one volume: grouping, sorting and geometry.
+
+use std::path::{Path, PathBuf};
+
+use dicom_dictionary_std::tags;
+use dicom_object::{DefaultDicomObject, InMemDicomObject};
+use glam::{Mat3, Vec3};
+
+use super::{PixelFormat, float, floats, group_value, int, open, pixel_bytes, string, vec3};
+use crate::volume::encode::{ByteOrder, encode_samples, encode_values};
+use crate::volume::grid::{lps_axes_to_ras, lps_to_ras};
+use crate::volume::readers::common::{Problem, ReadError, ReadOptions};
+use crate::volume::{Grid, Source, ValueMap, Volume};
+
+/// Where one frame (or slice) lies, in LPS millimetres, and how to rescale its values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameGeometry {
+    pub position: Option<Vec3>,
+    /// Row direction (along a row: increasing column index) and column direction.
+    pub orientation: Option<[Vec3; 2]>,
+    /// Pixel Spacing: (between rows, between columns).
+    pub pixel_spacing: Option<[f32; 2]>,
+    pub slope: f64,
+    pub intercept: f64,
+}
+
+fn frame_geometry(o: &InMemDicomObject, frame: Option<usize>) -> FrameGeometry {
+    let get = |seq, tag| match frame {
+        Some(f) => group_value(o, f, seq, tag).and_then(|e| e.to_multi_float64().ok()).filter(|v| v.iter().all(|x| x.is_finite())),
+        None => floats(o, tag),
+    };
+    let position = get(tags::PLANE_POSITION_SEQUENCE, tags::IMAGE_POSITION_PATIENT)
+        .or_else(|| floats(o, tags::IMAGE_POSITION_PATIENT))
+        .filter(|v| v.len() == 3)
+        .map(|v| vec3(&v));
+    let orientation = get(tags::PLANE_ORIENTATION_SEQUENCE, tags::IMAGE_ORIENTATION_PATIENT)
+        .or_else(|| floats(o, tags::IMAGE_ORIENTATION_PATIENT))
+        .filter(|v| v.len() == 6)
+        .map(|v| [vec3(&v[..3]), vec3(&v[3..])])
+        .filter(|[r, c]| r.length() > 0.5 && c.length() > 0.5 && r.cross(*c).length() > 0.5);
+    let pixel_spacing = get(tags::PIXEL_MEASURES_SEQUENCE, tags::PIXEL_SPACING)
+        .or_else(|| floats(o, tags::PIXEL_SPACING))
+        .or_else(|| floats(o, tags::IMAGER_PIXEL_SPACING))
+        .filter(|v| v.len() == 2 && v[0] > 0.0 && v[1] > 0.0)
+        .map(|v| [v[0] as f32, v[1] as f32]);
+    let rescale = |tag| match frame {
+        Some(f) => {
+            group_value(o, f, tags::PIXEL_VALUE_TRANSFORMATION_SEQUENCE, tag).and_then(|e| e.to_float64().ok()).or_else(|| float(o, tag))
+        }
+        None => float(o, tag),
+    };
+    let slope = rescale(tags::RESCALE_SLOPE).filter(|s| *s != 0.0).unwrap_or(1.0);
+    let intercept = rescale(tags::RESCALE_INTERCEPT).unwrap_or(0.0);
+    FrameGeometry { position, orientation, pixel_spacing, slope, intercept }
+}
+
+/// One slice (file) or frame with its pixels.
+struct Plane {
+    geometry: FrameGeometry,
+    instance: i64,
+    bytes: Vec<u8>,
+}
+
+/// Reads every DICOM file in `files` and assembles the largest series.
+pub fn read_series(dir: &Path, files: &[PathBuf], options: &ReadOptions) -> Result<Volume, ReadError> {
+    read_series_of(dir, files, None, options)
+}
+
+/// Like [`read_series`], restricted to one Series Instance UID when given.
+pub fn read_series_of(at: &Path, files: &[PathBuf], uid: Option<&str>, options: &ReadOptions) -> Result<Volume, ReadError> {
+    let mut objects: Vec<(PathBuf, DefaultDicomObject)> = Vec::new();
+    let mut first_error: Option<ReadError> = None;
+    let mut skipped = 0usize;
+    for f in files {
+        match open(f, options) {
+            Ok(o) => objects.push((f.clone(), o)),
+            Err(e) => {
+                // Non-DICOM files (DICOMDIR, notes) are common in exported folders.
+                if !matches!(e.problem, Problem::NotFormat { .. }) {
+                    skipped += 1;
+                    first_error.get_or_insert(e);
+                }
+            }
+        }
+    }
+    if objects.is_empty() {
+        return Err(first_error
+            .unwrap_or_else(|| ReadError::new(at, Problem::NotFormat { format: "DICOM", detail: "no DICOM files found".into() })));
+    }
+    // Group by series, image size and orientation.
+    let key = |o: &DefaultDicomObject| {
+        let g = frame_geometry(o, None);
+        let orient = g.orientation.map(|[r, c]| [r, c].map(|v| (v * 100.0).round().as_ivec3().to_array()));
+        (string(o, tags::SERIES_INSTANCE_UID), int(o, tags::ROWS), int(o, tags::COLUMNS), orient)
+    };
+    let mut groups: Vec<(_, Vec<usize>)> = Vec::new();
+    for (i, (_, o)) in objects.iter().enumerate() {
+        if let Some(u) = uid
+            && string(o, tags::SERIES_INSTANCE_UID).as_deref() != Some(u)
+        {
+            continue;
+        }
+        let k = key(o);
+        match groups.iter_mut().find(|(g, _)| *g == k) {
+            Some((_, v)) => v.push(i),
+            None => groups.push((k, vec![i])),
+        }
+    }
+    let Some((_, chosen)) = groups.iter().max_by_key(|(_, v)| v.len()) else {
+        return Err(ReadError::new(at, Problem::Malformed("no slice of the series was readable".into())));
+    };
+    let others = groups.len() - 1;
+    let (first_path, first) = &objects[chosen[0]];
+    let format = PixelFormat::of(first).map_err(|p| ReadError::new(first_path, p))?;
+    options
+        .check_size([format.cols as u64, format.rows as u64, chosen.len() as u64], format.bits_allocated as usize / 8)
+        .map_err(|p| ReadError::new(at, p))?;
+    let mut planes = Vec::with_capacity(chosen.len());
+    for &i in chosen {
+        let (p, o) = &objects[i];
+        let f = PixelFormat::of(o).map_err(|e| ReadError::new(p, e))?;
+        if f != format {
+            return Err(ReadError::new(p, Problem::Malformed("pixel format differs from the rest of the series".into())));
+        }
+        let bytes = pixel_bytes(o, &format, 1).map_err(|e| ReadError::new(p, e))?.into_owned();
+        planes.push(Plane {
+            geometry: frame_geometry(o, None),
+            instance: int(o, tags::INSTANCE_NUMBER).map(i64::from).unwrap_or(i as i64),
+            bytes,
+        });
+    }
+    let mut notes = Vec::new();
+    if others > 0 {
+        notes.push(format!("{others} other series (or image sizes) in the folder were not loaded"));
+    }
+    if skipped > 0 {
+        notes.push(format!("{skipped} unreadable file(s) skipped"));
+    }
+    let name = string(first, tags::SERIES_DESCRIPTION)
+        .unwrap_or_else(|| at.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "DICOM".into()));
+    assemble(at, first, format, planes, name, "DICOM series", notes)
+}
+
+/// Reads a multi-frame object.
+pub fn read_multiframe(path: &Path, object: DefaultDicomObject, options: &ReadOptions) -> Result<Volume, ReadError> {
+    let fail = |p: Problem| ReadError::new(path, p);
+    let format = PixelFormat::of(&object).map_err(fail)?;
+    let frames = int(&object, tags::NUMBER_OF_FRAMES).unwrap_or(1) as usize;
+    options.check_size([format.cols as u64, format.rows as u64, frames as u64], format.bits_allocated as usize / 8).map_err(fail)?;
+    let all = pixel_bytes(&object, &format, frames).map_err(fail)?;
+    let fb = format.frame_bytes();
+    let mut planes: Vec<Plane> = (0..frames)
+        .map(|f| Plane { geometry: frame_geometry(&object, Some(f)), instance: f as i64, bytes: all[f * fb..(f + 1) * fb].to_vec() })
+        .collect();
+    // Frames without their own position: stack them along the normal from the first.
+    if planes.iter().any(|p| p.geometry.position.is_none())
+        && let (Some(p0), Some([r, c])) = (
+            planes[0].geometry.position.or_else(|| floats(&object, tags::IMAGE_POSITION_PATIENT).map(|v| vec3(&v))),
+            planes[0].geometry.orientation,
+        )
+    {
+        let step = float(&object, tags::SPACING_BETWEEN_SLICES).or_else(|| float(&object, tags::SLICE_THICKNESS)).unwrap_or(1.0) as f32;
+        let n = r.cross(c).normalize();
+        for (k, p) in planes.iter_mut().enumerate() {
+            p.geometry.position = Some(p0 + n * step * k as f32);
+        }
+    }
+    drop(all);
+    let name = string(&object, tags::SERIES_DESCRIPTION).unwrap_or_else(|| super::super::nifti::volume_name(path));
+    assemble(path, &object, format, std::mem::take(&mut planes), name, "DICOM multi-frame", Vec::new())
+}
+
+/// Sorts planes along the slice normal, derives the grid and encodes the voxels.
+fn assemble(
+    at: &Path,
+    first: &DefaultDicomObject,
+    format: PixelFormat,
+    mut planes: Vec<Plane>,
+    name: String,
+    kind: &str,
+    mut notes: Vec<String>,
+) -> Result<Volume, ReadError> {
+    let fail = |p: Problem| ReadError::new(at, p);
+    let g0 = planes[0].geometry.clone();
+    let [row, col] = g0.orientation.unwrap_or([Vec3::X, Vec3::Y]);
+    if g0.orientation.is_none() {
+        notes.push("no Image Orientation (Patient): assumed axial".into());
+    }
+    let normal = row.cross(col).normalize();
+    let positioned = planes.iter().all(|p| p.geometry.position.is_some());
+    if positioned {
+        planes.sort_by(|a, b| {
+            let da = a.geometry.position.map(|p| p.dot(normal)).unwrap_or(0.0);
+            let db = b.geometry.position.map(|p| p.dot(normal)).unwrap_or(0.0);
+            da.total_cmp(&db)
+        });
+        let before = planes.len();
+        planes.dedup_by(|b, a| match (a.geometry.position, b.geometry.position) {
+            (Some(pa), Some(pb)) => (pa - pb).length() < 1e-3,
+            _ => false,
+        });
+        if planes.len() < before {
+            notes.push(format!(
+                "{} frame(s) at repeated positions skipped (several stacks or time points: showing the first)",
+                before - planes.len()
+            ));
+        }
+    } else {
+        planes.sort_by_key(|p| p.instance);
+        notes.push("slices have no Image Position (Patient): ordered by Instance Number".into());
+    }
+    let [ps_row, ps_col] = g0.pixel_spacing.unwrap_or_else(|| {
+        notes.push("no Pixel Spacing: 1 mm assumed".into());
+        [1.0, 1.0]
+    });
+    let n = planes.len();
+    let slice_axis = match (positioned, n) {
+        (true, n) if n >= 2 => {
+            let p0 = planes[0].geometry.position.unwrap_or(Vec3::ZERO);
+            let pn = planes[n - 1].geometry.position.unwrap_or(Vec3::ZERO);
+            let step = (pn - p0) / (n - 1) as f32;
+            let gaps: Vec<f32> =
+                planes.windows(2).filter_map(|w| Some((w[1].geometry.position? - w[0].geometry.position?).length())).collect();
+            let (lo, hi) = gaps.iter().fold((f32::INFINITY, 0.0f32), |(lo, hi), &g| (lo.min(g), hi.max(g)));
+            if hi - lo > 0.01 * step.length().max(1e-6) {
+                notes.push(format!("irregular slice spacing ({lo:.3}–{hi:.3} mm): using the mean {:.3} mm", step.length()));
+            }
+            step
+        }
+        _ => {
+            normal
+                * float(first, tags::SPACING_BETWEEN_SLICES)
+                    .or_else(|| float(first, tags::SLICE_THICKNESS))
+                    .filter(|s| *s > 0.0)
+                    .unwrap_or(1.0) as f32
+        }
+    };
+    let axes_lps = Mat3::from_cols(row.normalize() * ps_col, col.normalize() * ps_row, slice_axis);
+    let origin = planes[0].geometry.position.unwrap_or(Vec3::ZERO);
+    let dims = glam::UVec3::new(format.cols, format.rows, n as u32);
+    let grid = Grid::from_axes(dims, lps_axes_to_ras(axes_lps), lps_to_ras(origin))
+        .map_err(|e| fail(Problem::Malformed(format!("slice geometry: {e}"))))?;
+
+    let mut bytes = Vec::with_capacity(format.frame_bytes() * n);
+    for p in &planes {
+        bytes.extend_from_slice(&p.bytes);
+    }
+    format.normalise(&mut bytes);
+    let ty = format.sample_type();
+    let uniform = planes.iter().all(|p| p.geometry.slope == g0.slope && p.geometry.intercept == g0.intercept);
+    let encoded = if uniform {
+        let mut e = encode_samples(&bytes, ty, ByteOrder::Little).map_err(|e| fail(Problem::Values(e)))?;
+        e.map = e.map.then(g0.slope, g0.intercept);
+        e
+    } else {
+        // Rescale differs per frame: apply it to every value, then quantise once.
+        let raw = encode_samples(&bytes, ty, ByteOrder::Little).map_err(|e| fail(Problem::Values(e)))?;
+        let per = format.rows as usize * format.cols as usize;
+        let real: Vec<f64> = (0..raw.voxels.len())
+            .map(|i| {
+                let g = &planes[i / per].geometry;
+                raw.map.to_real(raw.voxels.code(i) as f64) * g.slope + g.intercept
+            })
+            .collect();
+        notes.push("rescale differs between frames: values quantised to 16 bits".into());
+        encode_values(&real, crate::volume::SampleType::F64).map_err(|e| fail(Problem::Values(e)))?
+    };
+    let modality = string(first, tags::MODALITY);
+    let units =
+        string(first, tags::RESCALE_TYPE).filter(|t| t != "US").or_else(|| (modality.as_deref() == Some("CT")).then(|| "HU".to_string()));
+    let values = ValueMap { units, ..encoded.map };
+
+    let mut details: Vec<(String, String)> = Vec::new();
+    let mut add = |k: &str, v: Option<String>| {
+        if let Some(v) = v {
+            details.push((k.to_string(), v));
+        }
+    };
+    add("modality", modality);
+    add("series", string(first, tags::SERIES_DESCRIPTION));
+    add("transfer syntax", Some(first.meta().transfer_syntax().to_string()));
+    add(
+        "window",
+        floats(first, tags::WINDOW_CENTER).zip(floats(first, tags::WINDOW_WIDTH)).map(|(c, w)| format!("centre {} width {}", c[0], w[0])),
+    );
+    add("slices", Some(n.to_string()));
+    for note in notes {
+        details.push(("note".into(), note));
+    }
+    let source = Source { format: kind.into(), path: Some(at.to_path_buf()), sample_type: ty.name().into(), details };
+    Volume::new(name, grid, encoded.voxels, values, source).map_err(|e| fail(Problem::Malformed(e)))
+}

@@ -1,0 +1,164 @@
+//! Value range, histogram and summary statistics of a volume.
+//!
+//! One parallel pass counts every code (256 or 65 536 counters); everything else —
+//! range, mean, standard deviation, percentiles and a histogram binned over the real
+//! value range — is derived from those counts exactly.
+
+use rayon::prelude::*;
+
+use super::voxels::{ValueMap, Voxels};
+
+/// Number of bins of the display histogram.
+pub const HISTOGRAM_BINS: usize = 256;
+
+/// Summary of the values in a volume, in real units.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ValueStats {
+    pub code_min: u16,
+    pub code_max: u16,
+    /// Smallest and largest real value present.
+    pub min: f64,
+    pub max: f64,
+    pub mean: f64,
+    pub std_dev: f64,
+    /// 1st, 50th and 99th percentile.
+    pub p01: f64,
+    pub median: f64,
+    pub p99: f64,
+    /// Number of voxels whose code is not the minimum (useful for masks and labels).
+    pub above_min: u64,
+    pub histogram: Histogram,
+}
+
+/// Counts of voxels in equal-width bins over `[min, max]` (real units).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Histogram {
+    pub min: f64,
+    pub max: f64,
+    pub counts: Vec<u64>,
+}
+
+impl Histogram {
+    /// Real value at the centre of bin `i`.
+    pub fn bin_center(&self, i: usize) -> f64 {
+        let w = (self.max - self.min) / self.counts.len() as f64;
+        self.min + (i as f64 + 0.5) * w
+    }
+
+    pub fn total(&self) -> u64 {
+        self.counts.iter().sum()
+    }
+}
+
+/// Counts of every code.
+pub fn code_counts(voxels: &Voxels) -> Vec<u64> {
+    fn count<T: Copy + Into<usize> + Sync>(v: &[T], n: usize) -> Vec<u64> {
+        v.par_chunks(1 << 16)
+            .fold(
+                || vec![0u64; n],
+                |mut acc, chunk| {
+                    for &c in chunk {
+                        acc[c.into()] += 1;
+                    }
+                    acc
+                },
+            )
+            .reduce(
+                || vec![0u64; n],
+                |mut a, b| {
+                    a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+                    a
+                },
+            )
+    }
+    match voxels {
+        Voxels::U8(v) => count(v, 256),
+        Voxels::U16(v) => count(v, 65536),
+    }
+}
+
+/// Computes the statistics of `voxels` under `map`.
+pub fn compute(voxels: &Voxels, map: &ValueMap) -> ValueStats {
+    let counts = code_counts(voxels);
+    from_counts(&counts, map)
+}
+
+/// Derives the statistics from per-code counts (at least one count must be non-zero).
+pub fn from_counts(counts: &[u64], map: &ValueMap) -> ValueStats {
+    let total: u64 = counts.iter().sum();
+    let code_min = counts.iter().position(|&c| c > 0).unwrap_or(0);
+    let code_max = counts.iter().rposition(|&c| c > 0).unwrap_or(0);
+    let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+    for (code, &c) in counts.iter().enumerate().filter(|(_, c)| **c > 0) {
+        let v = map.to_real(code as f64);
+        sum += v * c as f64;
+        sum2 += v * v * c as f64;
+    }
+    let n = total.max(1) as f64;
+    let mean = sum / n;
+    let std_dev = (sum2 / n - mean * mean).max(0.0).sqrt();
+    let percentile = |q: f64| {
+        let target = (q * total as f64).ceil().max(1.0) as u64;
+        let mut acc = 0;
+        for (code, &c) in counts.iter().enumerate() {
+            acc += c;
+            if acc >= target {
+                return map.to_real(code as f64);
+            }
+        }
+        map.to_real(code_max as f64)
+    };
+    let (lo, hi) = (map.to_real(code_min as f64), map.to_real(code_max as f64));
+    let (min, max) = (lo.min(hi), lo.max(hi));
+    let mut bins = vec![0u64; HISTOGRAM_BINS];
+    let width = (max - min).max(f64::MIN_POSITIVE);
+    for (code, &c) in counts.iter().enumerate().filter(|(_, c)| **c > 0) {
+        let v = map.to_real(code as f64);
+        let b = (((v - min) / width) * HISTOGRAM_BINS as f64) as usize;
+        bins[b.min(HISTOGRAM_BINS - 1)] += c;
+    }
+    ValueStats {
+        code_min: code_min as u16,
+        code_max: code_max as u16,
+        min,
+        max,
+        mean,
+        std_dev,
+        p01: percentile(0.01),
+        median: percentile(0.5),
+        p99: percentile(0.99),
+        above_min: total - counts.get(code_min).copied().unwrap_or(0),
+        histogram: Histogram { min, max, counts: bins },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn statistics_match_a_direct_computation() {
+        let values: Vec<u8> = (0..1000u32).map(|i| ((i * 37) % 200) as u8).collect();
+        let map = ValueMap::new(0.5, -10.0);
+        let s = compute(&Voxels::U8(values.clone()), &map);
+        let real: Vec<f64> = values.iter().map(|&v| v as f64 * 0.5 - 10.0).collect();
+        let mean = real.iter().sum::<f64>() / real.len() as f64;
+        let var = real.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / real.len() as f64;
+        assert!((s.mean - mean).abs() < 1e-9);
+        assert!((s.std_dev - var.sqrt()).abs() < 1e-9);
+        assert_eq!(s.min, -10.0);
+        assert_eq!(s.max, 199.0 * 0.5 - 10.0);
+        let mut sorted = real.clone();
+        sorted.sort_by(f64::total_cmp);
+        assert_eq!(s.median, sorted[499]);
+        assert_eq!(s.histogram.total(), 1000);
+        assert_eq!(s.histogram.counts.len(), HISTOGRAM_BINS);
+    }
+
+    #[test]
+    fn negative_slope_keeps_min_below_max() {
+        let s = compute(&Voxels::U16(vec![0, 10]), &ValueMap::new(-1.0, 0.0));
+        assert_eq!((s.min, s.max), (-10.0, 0.0));
+        assert_eq!(s.above_min, 1);
+    }
+}

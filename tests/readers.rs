@@ -1,0 +1,381 @@
+//! Readers on the real files of `../shared/data`, checked against values computed
+//! independently with nibabel, pynrrd, SimpleITK, pydicom and a hand-written VTI decoder
+//! in Python (the script and its output are summarised in each test).
+
+mod common;
+
+use common::{data, scratch};
+use focal::volume::readers::{Problem, RawSpec, ReadOptions, label_table, read_label_volume, read_volume};
+use focal::volume::{Volume, Voxels};
+use glam::{Mat4, Vec3, Vec4};
+
+/// Expected facts about one file. `affine` is the index→world RAS matrix, row-major.
+struct Truth {
+    dims: [u32; 3],
+    bits: u32,
+    min: f64,
+    max: f64,
+    mean: f64,
+    /// (index, real value).
+    samples: [([u32; 3], f64); 3],
+    affine: [[f32; 4]; 3],
+}
+
+fn check(v: &Volume, t: &Truth, affine_tol: f32) {
+    assert_eq!(v.dims().to_array(), t.dims, "{}", v.name);
+    assert_eq!(v.voxels.bits(), t.bits, "{}", v.name);
+    assert_eq!((v.stats.min, v.stats.max), (t.min, t.max), "{}", v.name);
+    assert!((v.stats.mean - t.mean).abs() < 1e-3, "{} mean {} vs {}", v.name, v.stats.mean, t.mean);
+    for (ijk, value) in t.samples {
+        assert_eq!(v.real(ijk[0], ijk[1], ijk[2]), value, "{} at {ijk:?}", v.name);
+    }
+    let m = Mat4::from(v.grid.index_to_world());
+    for (r, row) in t.affine.iter().enumerate() {
+        let got = m.row(r);
+        let want = Vec4::from_array(*row);
+        assert!((got - want).abs().max_element() < affine_tol, "{} affine row {r}: {got} vs {want}", v.name);
+    }
+}
+
+fn read(rel: &str) -> Volume {
+    read_volume(&data(rel), &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn nifti_ch2_uses_the_sform() {
+    let v = read("mri/ch2.nii.gz");
+    check(
+        &v,
+        &Truth {
+            dims: [181, 217, 181],
+            bits: 8,
+            min: 0.0,
+            max: 254.0,
+            mean: 44.6118,
+            samples: [([0, 0, 0], 0.0), ([90, 108, 90], 33.0), ([60, 54, 36], 92.0)],
+            affine: [[1.0, 0.0, 0.0, -90.0], [0.0, 1.0, 0.0, -125.0], [0.0, 0.0, 1.0, -71.0]],
+        },
+        1e-4,
+    );
+    assert_eq!(v.source.format, "NIfTI-1");
+    assert_eq!(v.grid.orientation_code(), "RAS");
+    // World (0, 0, 0) is voxel (90, 125, 71) with value 32.
+    let q = v.grid.world_to_index().transform_point3(Vec3::ZERO).round().as_uvec3();
+    assert_eq!((q.to_array(), v.real(q.x, q.y, q.z)), ([90, 125, 71], 32.0));
+}
+
+#[test]
+fn nifti_fuel() {
+    let v = read("ct/fuel.nii.gz");
+    check(
+        &v,
+        &Truth {
+            dims: [64, 33, 32],
+            bits: 8,
+            min: 0.0,
+            max: 255.0,
+            mean: 7.5434,
+            samples: [([0, 0, 0], 0.0), ([32, 16, 16], 189.0), ([21, 8, 6], 0.0)],
+            affine: [[1.0, 0.0, 0.0, -31.0], [0.0, 1.0, 0.0, -16.0], [0.0, 0.0, 1.0, -16.0]],
+        },
+        1e-4,
+    );
+}
+
+#[test]
+fn nrrd_flair_is_oblique_lps() {
+    let v = read("mri/FLAIR.nrrd");
+    check(
+        &v,
+        &Truth {
+            dims: [124, 160, 140],
+            bits: 8,
+            min: 0.0,
+            max: 255.0,
+            mean: 41.486,
+            samples: [([0, 0, 0], 0.0), ([62, 80, 70], 170.0), ([41, 40, 28], 125.0)],
+            affine: [
+                [0.993592, 0.016005, 0.111887, -64.898239],
+                [-0.049705, 0.950937, 0.305367, -110.431145],
+                [-0.10151, -0.308971, 0.945639, -27.925539],
+            ],
+        },
+        1e-4,
+    );
+    assert!(!v.grid.is_orthogonal() || v.grid.direction.x_axis.x < 0.9999, "oblique");
+}
+
+#[test]
+fn metaimage_epi_int16_compressed() {
+    let v = read("mri/epi_64x64x37.mha");
+    check(
+        &v,
+        &Truth {
+            dims: [64, 64, 37],
+            bits: 16,
+            min: 0.0,
+            max: 6690.0,
+            mean: 527.5062,
+            samples: [([0, 0, 0], 0.0), ([32, 32, 18], 4369.0), ([21, 16, 7], 2123.0)],
+            affine: [[-3.4375, 0.0, 0.0, 108.281], [0.0, 3.4375, 0.0, -82.3795], [0.0, 0.0, 3.8, -47.8356]],
+        },
+        1e-3,
+    );
+    assert_eq!(v.source.sample_type, "int16");
+}
+
+#[test]
+fn vti_engine_raw_appended_uint64_zlib() {
+    let v = read("ct/engine.vti");
+    check(
+        &v,
+        &Truth {
+            dims: [256, 256, 128],
+            bits: 8,
+            min: 0.0,
+            max: 255.0,
+            mean: 22.3488,
+            samples: [([0, 0, 0], 0.0), ([128, 128, 64], 133.0), ([85, 64, 25], 97.0)],
+            affine: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]],
+        },
+        1e-6,
+    );
+}
+
+#[test]
+fn vti_frog_labels_inline_base64_uint32() {
+    let path = data("labels/frog_tissues.vti");
+    let v = read_volume(&path, &ReadOptions::default()).unwrap();
+    check(
+        &v,
+        &Truth {
+            dims: [500, 470, 136],
+            bits: 8,
+            min: 0.0,
+            max: 29.0,
+            mean: 0.3831,
+            samples: [([0, 0, 0], 0.0), ([250, 235, 68], 6.0), ([166, 117, 27], 0.0)],
+            affine: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.5, 0.0]],
+        },
+        1e-6,
+    );
+    let labels = read_label_volume(&path, None, &ReadOptions::default()).unwrap();
+    let ids: Vec<u32> = labels.present_ids().into_iter().map(|(id, _)| id).filter(|&id| id != 0).collect();
+    assert_eq!(ids.len(), 25);
+    assert!(!ids.contains(&18) && ids.contains(&29));
+}
+
+#[test]
+fn dicom_series_sorted_along_the_normal() {
+    let v = read("dicom/mr_3slices");
+    check(
+        &v,
+        &Truth {
+            dims: [512, 512, 3],
+            bits: 16,
+            min: 0.0,
+            max: 507.0,
+            mean: 79.4543,
+            samples: [([0, 0, 0], 0.0), ([256, 256, 1], 32.0), ([170, 128, 0], 239.0)],
+            affine: [[-0.41015625, 0.0, 0.0, 106.326809], [0.0, -0.41015625, 0.0, 123.074438], [0.0, 0.0, 1.5, -92.000669]],
+        },
+        2e-4,
+    );
+    assert_eq!(v.source.format, "DICOM series");
+    // Opening one slice gathers the same series.
+    let one = read("dicom/mr_3slices/1-002.dcm");
+    assert_eq!(one.dims().to_array(), [512, 512, 3]);
+    assert_eq!(one.voxels, v.voxels);
+}
+
+#[test]
+fn dicom_enhanced_multiframe() {
+    let v = read("dicom/enhanced_mr_multiframe.dcm");
+    check(
+        &v,
+        &Truth {
+            dims: [64, 64, 6],
+            bits: 16,
+            min: 0.0,
+            max: 1195.0,
+            mean: 101.5113,
+            samples: [([0, 0, 0], 0.0), ([32, 32, 3], 560.0), ([21, 16, 1], 11.0)],
+            affine: [[-3.375, 0.0, 0.0, 109.79], [0.0, -3.375, 2e-5, 58.4773], [3e-6, 3e-6, 2.4, -5.40356]],
+        },
+        2e-4,
+    );
+    assert_eq!(v.source.format, "DICOM multi-frame");
+}
+
+#[test]
+fn aal_labels_with_names_and_colours() {
+    let path = data("labels/aal.nii.gz");
+    let labels = read_label_volume(&path, None, &ReadOptions::default()).unwrap();
+    let ids = labels.present_ids();
+    assert_eq!(ids.iter().filter(|(id, _)| *id != 0).count(), 116);
+    assert_eq!(labels.table.name(1), "Precentral_L");
+    assert_eq!(labels.table.name(116), "Vermis_10");
+    // Colours come from aal.nii.lut (planar R, G, B).
+    let lut = std::fs::read(data("labels/aal.nii.lut")).unwrap();
+    assert_eq!(labels.table.color(1), [lut[1], lut[257], lut[513]]);
+    assert_eq!(labels.id(60, 54, 36), 91);
+    let table = label_table::read(&data("labels/aal.nii.txt")).unwrap();
+    assert_eq!(table.len(), 116);
+}
+
+#[test]
+fn nifti2_and_analyze_style_pair() {
+    // Re-write fuel.nii.gz as NIfTI-2 (540-byte header) and as a NIfTI-1 .hdr/.img pair.
+    let src = read("ct/fuel.nii.gz");
+    let dir = scratch("nifti2");
+    let Voxels::U8(codes) = &src.voxels else { panic!("fuel is 8-bit") };
+    let mut h = vec![0u8; 544];
+    h[0..4].copy_from_slice(&540i32.to_le_bytes());
+    h[4..12].copy_from_slice(b"n+2\0\r\n\x1a\n");
+    h[12..14].copy_from_slice(&2i16.to_le_bytes()); // uint8
+    h[14..16].copy_from_slice(&8i16.to_le_bytes());
+    for (i, d) in [3i64, 64, 33, 32, 1, 1, 1, 1].iter().enumerate() {
+        h[16 + 8 * i..24 + 8 * i].copy_from_slice(&d.to_le_bytes());
+    }
+    for (i, p) in [1.0f64, 2.0, 2.0, 3.0, 1.0, 1.0, 1.0, 1.0].iter().enumerate() {
+        h[104 + 8 * i..112 + 8 * i].copy_from_slice(&p.to_le_bytes());
+    }
+    h[168..176].copy_from_slice(&544i64.to_le_bytes());
+    h[176..184].copy_from_slice(&2.0f64.to_le_bytes()); // scl_slope
+    h[184..192].copy_from_slice(&(-10.0f64).to_le_bytes()); // scl_inter
+    h[348..352].copy_from_slice(&2i32.to_le_bytes()); // sform_code
+    let srow = [[2.0f64, 0.0, 0.0, 5.0], [0.0, 2.0, 0.0, 6.0], [0.0, 0.0, 3.0, 7.0]];
+    for (r, row) in srow.iter().enumerate() {
+        for (c, x) in row.iter().enumerate() {
+            h[400 + 32 * r + 8 * c..408 + 32 * r + 8 * c].copy_from_slice(&x.to_le_bytes());
+        }
+    }
+    h[500..504].copy_from_slice(&2i32.to_le_bytes()); // mm
+    let mut file = h.clone();
+    file.extend_from_slice(codes);
+    let p2 = dir.join("fuel2.nii");
+    std::fs::write(&p2, &file).unwrap();
+    let v = read_volume(&p2, &ReadOptions::default()).unwrap();
+    assert_eq!(v.source.format, "NIfTI-2");
+    assert_eq!(v.grid.spacing, Vec3::new(2.0, 2.0, 3.0));
+    assert_eq!(v.grid.origin, Vec3::new(5.0, 6.0, 7.0));
+    assert_eq!(v.real(32, 16, 16), 189.0 * 2.0 - 10.0);
+    // Truncated NIfTI-2 data is reported as such.
+    std::fs::write(&p2, &file[..file.len() - 100]).unwrap();
+    let e = read_volume(&p2, &ReadOptions::default()).unwrap_err();
+    assert!(matches!(e.problem, Problem::Truncated(_)), "{e}");
+    assert!(e.to_string().contains("fuel2.nii"), "{e}");
+
+    // NIfTI-1 pair: the header of fuel.nii.gz with magic "ni1" and vox_offset 0.
+    let mut gz = flate2::read::GzDecoder::new(std::fs::File::open(data("ct/fuel.nii.gz")).unwrap());
+    let mut all = Vec::new();
+    std::io::Read::read_to_end(&mut gz, &mut all).unwrap();
+    let mut hdr = all[..348].to_vec();
+    hdr[108..112].copy_from_slice(&0f32.to_le_bytes());
+    hdr[344..348].copy_from_slice(b"ni1\0");
+    std::fs::write(dir.join("pair.hdr"), &hdr).unwrap();
+    std::fs::write(dir.join("pair.img"), &all[352..]).unwrap();
+    for p in ["pair.hdr", "pair.img"] {
+        let v = read_volume(&dir.join(p), &ReadOptions::default()).unwrap();
+        assert_eq!(v.voxels, src.voxels, "{p}");
+    }
+}
+
+#[test]
+fn raw_and_volvis_dat() {
+    let src = read("ct/fuel.nii.gz");
+    let Voxels::U8(codes) = &src.voxels else { panic!("fuel is 8-bit") };
+    let dir = scratch("raw");
+    std::fs::write(dir.join("fuel.raw"), codes).unwrap();
+    let spec: RawSpec = "64x33x32:uint8:s=1x1x2".parse().unwrap();
+    let opts = ReadOptions { raw: Some(spec), ..Default::default() };
+    let v = read_volume(&dir.join("fuel.raw"), &opts).unwrap();
+    assert_eq!(v.voxels, src.voxels);
+    assert_eq!(v.grid.spacing.z, 2.0);
+    // The same through a volvis .dat header.
+    std::fs::write(
+        dir.join("fuel.dat"),
+        "ObjectFileName: fuel.raw\nTaggedFileName: ---\nResolution: 64 33 32\nSliceThickness: 1 1 1\nFormat: UCHAR\n",
+    )
+    .unwrap();
+    let d = read_volume(&dir.join("fuel.dat"), &ReadOptions::default()).unwrap();
+    assert_eq!(d.voxels, src.voxels);
+    // TU Wien binary .dat: three u16 dims, then u16 voxels.
+    let mut bin: Vec<u8> = [4u16, 2, 2].iter().flat_map(|d| d.to_le_bytes()).collect();
+    bin.extend((0..16u16).flat_map(|v| (v * 100).to_le_bytes()));
+    std::fs::write(dir.join("tiny.dat"), &bin).unwrap();
+    let t = read_volume(&dir.join("tiny.dat"), &ReadOptions::default()).unwrap();
+    assert_eq!((t.dims().to_array(), t.real(3, 1, 1)), ([4, 2, 2], 1500.0));
+    // A raw file too short for its dimensions.
+    let short = ReadOptions { raw: Some("64x33x33:uint8".parse().unwrap()), ..Default::default() };
+    let e = read_volume(&dir.join("fuel.raw"), &short).unwrap_err();
+    assert!(matches!(e.problem, Problem::Truncated(_)), "{e}");
+}
+
+#[test]
+fn nrrd_detached_ascii_and_big_endian() {
+    let dir = scratch("nrrd");
+    let values: Vec<i16> = (0..24).map(|i| i * 10 - 50).collect();
+    std::fs::write(dir.join("d.raw"), values.iter().flat_map(|v| v.to_be_bytes()).collect::<Vec<u8>>()).unwrap();
+    std::fs::write(dir.join("d.nhdr"), "NRRD0004\ntype: short\ndimension: 3\nsizes: 4 3 2\nencoding: raw\nendian: big\nspace: RAS\nspace directions: (2,0,0) (0,2,0) (0,0,3)\nspace origin: (1,2,3)\ndata file: d.raw\n").unwrap();
+    let v = read_volume(&dir.join("d.nhdr"), &ReadOptions::default()).unwrap();
+    assert_eq!(v.real(3, 2, 1), 23.0 * 10.0 - 50.0);
+    assert_eq!(v.grid.origin, Vec3::new(1.0, 2.0, 3.0));
+    let text: String = values.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(" ");
+    std::fs::write(
+        dir.join("a.nrrd"),
+        format!("NRRD0004\ntype: short\ndimension: 3\nsizes: 4 3 2\nencoding: ascii\nspacings: 1 1 2\n\n{text}\n"),
+    )
+    .unwrap();
+    let a = read_volume(&dir.join("a.nrrd"), &ReadOptions::default()).unwrap();
+    assert_eq!(a.voxels, v.voxels);
+    assert_eq!(a.grid.spacing.z, 2.0);
+    // Unknown encodings and types are named.
+    std::fs::write(dir.join("b.nrrd"), "NRRD0004\ntype: short\ndimension: 3\nsizes: 4 3 2\nencoding: zstd\nendian: little\n\n").unwrap();
+    let e = read_volume(&dir.join("b.nrrd"), &ReadOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("zstd") && e.to_string().contains("b.nrrd"), "{e}");
+}
+
+#[test]
+fn absurd_sizes_are_refused_before_allocating() {
+    let dir = scratch("absurd");
+    std::fs::write(
+        dir.join("huge.nhdr"),
+        "NRRD0004\ntype: float\ndimension: 3\nsizes: 60000 60000 60000\nencoding: raw\nendian: little\ndata file: x.raw\n",
+    )
+    .unwrap();
+    let e = read_volume(&dir.join("huge.nhdr"), &ReadOptions::default()).unwrap_err();
+    assert!(matches!(e.problem, Problem::TooLarge(_)), "{e}");
+    std::fs::write(
+        dir.join("huge.mha"),
+        "ObjectType = Image\nNDims = 3\nDimSize = 2000 2000 2000\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n",
+    )
+    .unwrap();
+    let e = read_volume(&dir.join("huge.mha"), &ReadOptions::default()).unwrap_err();
+    assert!(matches!(e.problem, Problem::TooLarge(_)), "{e}");
+    // Within the limits but far larger than the file: truncation, no 4 GB buffer.
+    std::fs::write(
+        dir.join("big.mha"),
+        "ObjectType = Image\nNDims = 3\nDimSize = 1000 1000 1000\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n\x01\x02",
+    )
+    .unwrap();
+    let e = read_volume(&dir.join("big.mha"), &ReadOptions::default()).unwrap_err();
+    assert!(matches!(e.problem, Problem::Truncated(_)), "{e}");
+}
+
+#[test]
+fn unknown_files_are_named() {
+    let dir = scratch("unknown");
+    std::fs::write(dir.join("notes.xyz"), "hello").unwrap();
+    let e = read_volume(&dir.join("notes.xyz"), &ReadOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("notes.xyz") && e.to_string().contains("unknown file format"), "{e}");
+    let e = read_volume(&dir.join("missing.nii"), &ReadOptions::default()).unwrap_err();
+    assert!(matches!(e.problem, Problem::Io(_)), "{e}");
+    // A float volume with NaNs is refused, not rendered with holes.
+    let mut nan = b"ObjectType = Image\nNDims = 3\nDimSize = 2 1 1\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n".to_vec();
+    nan.extend(1.0f32.to_le_bytes());
+    nan.extend(f32::NAN.to_le_bytes());
+    std::fs::write(dir.join("nan.mha"), nan).unwrap();
+    let e = read_volume(&dir.join("nan.mha"), &ReadOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("NaN"), "{e}");
+}
