@@ -6,7 +6,7 @@ use std::time::Instant;
 use clap::Args;
 use focal::reference::{RenderScene, render};
 use focal::region::{Appearance, Lookup, Mode, View};
-use focal::transfer::{LabelTransfer, presets};
+use focal::transfer::{LabelTransfer, Lut, presets};
 use focal::volume::readers::RawSpec;
 use focal::volume::{LabelTable, LabelVolume};
 
@@ -41,6 +41,9 @@ pub struct RenderArgs {
     /// Jitter ray starts (removes wood-grain rings; adds fine noise).
     #[arg(long)]
     jitter: bool,
+    /// Turn Blinn-Phong shading off.
+    #[arg(long)]
+    no_shading: bool,
     /// Render as a label volume with the colours of its label table.
     #[arg(long)]
     labels: bool,
@@ -92,10 +95,16 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     };
     let mut appearance = Appearance { lookup, ..Appearance::new(args.mode, presets::builtin("grayscale_ramp")?) };
     appearance.step = args.step;
+    appearance.shading.enabled = !args.no_shading;
     appearance.iso_value = args.iso.unwrap_or((target.stats.min + target.stats.max) * 0.5);
     let mut scene = RenderScene::single(target, appearance);
     scene.jitter = args.jitter;
-    let (lo, hi) = target.grid.world_bounds();
+    // Frame what the transfer function shows (the whole box for projections and labels).
+    let visible = match (&scene.appearances[0].lookup, args.mode.is_projection()) {
+        (Lookup::Transfer(tf), false) => Lut::for_volume(tf, target).visible_bounds(target),
+        _ => None,
+    };
+    let (lo, hi) = visible.unwrap_or_else(|| target.grid.world_bounds());
     let camera = args.view.frame((lo + hi) * 0.5, (hi - lo).length() * 0.5, args.ortho);
     let t = Instant::now();
     let image = render(&scene, &camera, w, h)?;
@@ -126,6 +135,7 @@ pub fn run_default(volume: Option<&Path>, out: &Path) -> Result<(), String> {
         step: 0.5,
         iso: None,
         jitter: true,
+        no_shading: false,
         labels: false,
         raw: None,
         resolution: 256,

@@ -94,6 +94,26 @@ impl BrickGrid {
     }
 }
 
+impl BrickGrid {
+    /// Continuous voxel-index box `(lo, hi)` enclosing the bricks where `keep` is true.
+    pub fn bounds_where(&self, keep: &[bool]) -> Option<(Vec3, Vec3)> {
+        let mut lo = UVec3::MAX;
+        let mut hi = UVec3::ZERO;
+        for z in 0..self.dims.z {
+            for y in 0..self.dims.y {
+                for x in 0..self.dims.x {
+                    let b = UVec3::new(x, y, z);
+                    if keep.get(self.index(b)).copied().unwrap_or(false) {
+                        lo = lo.min(b);
+                        hi = hi.max(b);
+                    }
+                }
+            }
+        }
+        (lo.x <= hi.x).then(|| (self.brick_bounds(lo).0, self.brick_bounds(hi).1))
+    }
+}
+
 fn range_of<T: Copy + Into<u16> + Ord>(v: &[T], dims: UVec3, lo: UVec3, hi: UVec3) -> (u16, u16) {
     let (nx, ny) = (dims.x as usize, dims.y as usize);
     let (mut mn, mut mx) = (u16::MAX, 0u16);
@@ -157,5 +177,10 @@ mod tests {
         }
         assert_eq!(g.brick_at(Vec3::new(-0.5, 3.4, 12.0)), UVec3::new(0, 0, 2));
         assert_eq!(g.occupancy(|_, hi| hi > 990).len(), g.len());
+        let mut keep = vec![false; g.len()];
+        keep[g.index(UVec3::new(1, 2, 0))] = true;
+        keep[g.index(UVec3::new(2, 0, 1))] = true;
+        assert_eq!(g.bounds_where(&keep), Some((Vec3::new(3.5, -0.5, -0.5), Vec3::new(11.5, 11.5, 7.5))));
+        assert_eq!(g.bounds_where(&vec![false; g.len()]), None);
     }
 }

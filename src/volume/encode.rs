@@ -74,14 +74,25 @@ pub struct Encoded {
     pub map: ValueMap,
 }
 
-/// Encodes `bytes`, which must hold a whole number of samples of `ty` in `order`.
-pub fn encode_samples(bytes: &[u8], ty: SampleType, order: ByteOrder) -> Result<Encoded, String> {
+/// Encodes `bytes`, which must hold a whole number of samples of `ty` in `order`
+/// (8-bit data is moved, not copied).
+pub fn encode_samples(bytes: Vec<u8>, ty: SampleType, order: ByteOrder) -> Result<Encoded, String> {
     let size = ty.size();
     if bytes.len() % size != 0 {
         return Err(format!("{} bytes is not a whole number of {} samples", bytes.len(), ty.name()));
     }
     match (ty, order) {
-        (SampleType::U8, _) => Ok(Encoded { voxels: Voxels::U8(bytes.to_vec()), map: ValueMap::IDENTITY }),
+        (SampleType::U8, _) => Ok(Encoded { voxels: Voxels::U8(bytes), map: ValueMap::IDENTITY }),
+        (SampleType::I16, _) if !bytes.is_empty() => {
+            // The common CT case, in two vectorisable passes: the raw bits, then the shift.
+            let mut codes: Vec<u16> = match order {
+                ByteOrder::Little => bytes.chunks_exact(2).map(|b| u16::from_le_bytes([b[0], b[1]])).collect(),
+                ByteOrder::Big => bytes.chunks_exact(2).map(|b| u16::from_be_bytes([b[0], b[1]])).collect(),
+            };
+            let lo = codes.iter().map(|&c| c as i16).min().unwrap_or(0);
+            codes.iter_mut().for_each(|c| *c = c.wrapping_sub(lo as u16));
+            Ok(Encoded { voxels: Voxels::U16(codes), map: ValueMap::new(1.0, lo as f64) })
+        }
         (SampleType::U16, ByteOrder::Little) => Ok(Encoded {
             voxels: Voxels::U16(bytes.chunks_exact(2).map(|b| u16::from_le_bytes([b[0], b[1]])).collect()),
             map: ValueMap::IDENTITY,
@@ -90,7 +101,7 @@ pub fn encode_samples(bytes: &[u8], ty: SampleType, order: ByteOrder) -> Result<
             voxels: Voxels::U16(bytes.chunks_exact(2).map(|b| u16::from_be_bytes([b[0], b[1]])).collect()),
             map: ValueMap::IDENTITY,
         }),
-        _ => encode_general(bytes, ty, order),
+        _ => encode_general(&bytes, ty, order),
     }
 }
 
@@ -171,19 +182,19 @@ mod tests {
 
     #[test]
     fn unsigned_types_keep_their_codes() {
-        let e = encode_samples(&[1, 2, 255], SampleType::U8, ByteOrder::Little).unwrap();
+        let e = encode_samples(vec![1, 2, 255], SampleType::U8, ByteOrder::Little).unwrap();
         assert_eq!(e.voxels, Voxels::U8(vec![1, 2, 255]));
-        let e = encode_samples(&[0x01, 0x02], SampleType::U16, ByteOrder::Big).unwrap();
+        let e = encode_samples(vec![0x01, 0x02], SampleType::U16, ByteOrder::Big).unwrap();
         assert_eq!(e.voxels, Voxels::U16(vec![0x0102]));
     }
 
     #[test]
     fn signed_types_are_shifted_losslessly() {
         let raw: Vec<u8> = [-1024i16, 0, 3071].iter().flat_map(|v| v.to_le_bytes()).collect();
-        let e = encode_samples(&raw, SampleType::I16, ByteOrder::Little).unwrap();
+        let e = encode_samples(raw, SampleType::I16, ByteOrder::Little).unwrap();
         assert_eq!(e.voxels, Voxels::U16(vec![0, 1024, 4095]));
         assert_eq!((real(&e, 0), real(&e, 1), real(&e, 2)), (-1024.0, 0.0, 3071.0));
-        let e = encode_samples(&[0x80, 0x7f], SampleType::I8, ByteOrder::Little).unwrap();
+        let e = encode_samples(vec![0x80, 0x7f], SampleType::I8, ByteOrder::Little).unwrap();
         assert_eq!(e.voxels, Voxels::U8(vec![0, 255]));
         assert_eq!(real(&e, 0), -128.0);
     }
@@ -191,30 +202,33 @@ mod tests {
     #[test]
     fn floats_are_quantised_over_their_true_range() {
         let raw: Vec<u8> = [-1.5f32, 0.25, 2.0].iter().flat_map(|v| v.to_be_bytes()).collect();
-        let e = encode_samples(&raw, SampleType::F32, ByteOrder::Big).unwrap();
+        let be16: Vec<u8> = [-5i16, 300].iter().flat_map(|v| v.to_be_bytes()).collect();
+        let e16 = encode_samples(be16, SampleType::I16, ByteOrder::Big).unwrap();
+        assert_eq!((real(&e16, 0), real(&e16, 1)), (-5.0, 300.0));
+        let e = encode_samples(raw, SampleType::F32, ByteOrder::Big).unwrap();
         assert_eq!(e.voxels.code(0), 0);
         assert_eq!(e.voxels.code(2), 65535);
         assert!((real(&e, 1) - 0.25).abs() < 3.5 / 65535.0);
         assert_eq!(real(&e, 2), 2.0);
         // Whole-number floats (a label map saved as float) stay exact.
         let raw: Vec<u8> = [0.0f64, 17.0, 116.0].iter().flat_map(|v| v.to_le_bytes()).collect();
-        let e = encode_samples(&raw, SampleType::F64, ByteOrder::Little).unwrap();
+        let e = encode_samples(raw, SampleType::F64, ByteOrder::Little).unwrap();
         assert_eq!(e.voxels, Voxels::U16(vec![0, 17, 116]));
     }
 
     #[test]
     fn non_finite_and_ragged_input_are_errors() {
         let raw: Vec<u8> = [1.0f32, f32::NAN].iter().flat_map(|v| v.to_le_bytes()).collect();
-        let err = encode_samples(&raw, SampleType::F32, ByteOrder::Little).unwrap_err();
+        let err = encode_samples(raw, SampleType::F32, ByteOrder::Little).unwrap_err();
         assert!(err.contains("NaN"), "{err}");
-        assert!(encode_samples(&[1, 2, 3], SampleType::I16, ByteOrder::Little).is_err());
-        assert!(encode_samples(&[], SampleType::I32, ByteOrder::Little).is_err());
+        assert!(encode_samples(vec![1, 2, 3], SampleType::I16, ByteOrder::Little).is_err());
+        assert!(encode_samples(vec![], SampleType::I32, ByteOrder::Little).is_err());
     }
 
     #[test]
     fn wide_ranges_are_quantised() {
         let raw: Vec<u8> = [0i32, 100_000, 1_000_000].iter().flat_map(|v| v.to_le_bytes()).collect();
-        let e = encode_samples(&raw, SampleType::I32, ByteOrder::Little).unwrap();
+        let e = encode_samples(raw, SampleType::I32, ByteOrder::Little).unwrap();
         assert_eq!(real(&e, 2), 1_000_000.0);
         assert!((real(&e, 1) - 100_000.0).abs() <= 1_000_000.0 / 65535.0);
     }

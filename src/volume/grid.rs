@@ -106,9 +106,12 @@ impl Grid {
 
     /// The eight world-space corners of the box covered by the voxel cells.
     pub fn corners(&self) -> [Vec3; 8] {
+        self.index_box_corners(Vec3::splat(-0.5), self.dims.as_vec3() - 0.5)
+    }
+
+    /// The world-space corners of the continuous index box `[lo, hi]`.
+    pub fn index_box_corners(&self, lo: Vec3, hi: Vec3) -> [Vec3; 8] {
         let m = self.index_to_world();
-        let lo = Vec3::splat(-0.5);
-        let hi = self.dims.as_vec3() - 0.5;
         std::array::from_fn(|c| {
             let p =
                 Vec3::new(if c & 1 == 0 { lo.x } else { hi.x }, if c & 2 == 0 { lo.y } else { hi.y }, if c & 4 == 0 { lo.z } else { hi.z });
@@ -116,9 +119,14 @@ impl Grid {
         })
     }
 
+    /// Axis-aligned world bounds of the continuous index box `[lo, hi]`.
+    pub fn index_box_world_bounds(&self, lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
+        self.index_box_corners(lo, hi).iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), &c| (a.min(c), b.max(c)))
+    }
+
     /// Axis-aligned world bounds of the data box.
     pub fn world_bounds(&self) -> (Vec3, Vec3) {
-        self.corners().iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &c| (lo.min(c), hi.max(c)))
+        self.index_box_world_bounds(Vec3::splat(-0.5), self.dims.as_vec3() - 0.5)
     }
 
     /// World position of the centre of the data box.

@@ -50,30 +50,34 @@ impl Histogram {
     }
 }
 
-/// Counts of every code.
+/// Counts of every code from 0 to the largest present (in parallel for large volumes).
 pub fn code_counts(voxels: &Voxels) -> Vec<u64> {
-    fn count<T: Copy + Into<usize> + Sync>(v: &[T], n: usize) -> Vec<u64> {
-        v.par_chunks(1 << 16)
-            .fold(
-                || vec![0u64; n],
-                |mut acc, chunk| {
-                    for &c in chunk {
-                        acc[c.into()] += 1;
-                    }
-                    acc
-                },
-            )
-            .reduce(
-                || vec![0u64; n],
-                |mut a, b| {
-                    a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
-                    a
-                },
-            )
+    // Tallies only span the codes in use (cache-friendly for 16-bit data with a narrow
+    // range), in u32 per chunk (a chunk never holds 2³² voxels).
+    fn count<T: Copy + Into<usize> + Ord + Sync>(v: &[T]) -> Vec<u64> {
+        let n = v.iter().copied().max().map_or(0, Into::into) + 1;
+        let tally = |chunk: &[T]| {
+            let mut acc = vec![0u32; n];
+            for &c in chunk {
+                acc[c.into()] += 1;
+            }
+            acc.into_iter().map(u64::from).collect::<Vec<u64>>()
+        };
+        if v.len() < 1 << 20 {
+            return tally(v);
+        }
+        let chunk = v.len().div_ceil(rayon::current_num_threads().max(1)).min(u32::MAX as usize);
+        v.par_chunks(chunk).map(tally).reduce(
+            || vec![0u64; n],
+            |mut a, b| {
+                a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+                a
+            },
+        )
     }
     match voxels {
-        Voxels::U8(v) => count(v, 256),
-        Voxels::U16(v) => count(v, 65536),
+        Voxels::U8(v) => count(v),
+        Voxels::U16(v) => count(v),
     }
 }
 
@@ -83,50 +87,47 @@ pub fn compute(voxels: &Voxels, map: &ValueMap) -> ValueStats {
     from_counts(&counts, map)
 }
 
-/// Derives the statistics from per-code counts (at least one count must be non-zero).
+/// Derives the statistics from per-code counts (at least one count must be non-zero),
+/// in one pass over the codes present.
 pub fn from_counts(counts: &[u64], map: &ValueMap) -> ValueStats {
     let total: u64 = counts.iter().sum();
     let code_min = counts.iter().position(|&c| c > 0).unwrap_or(0);
     let code_max = counts.iter().rposition(|&c| c > 0).unwrap_or(0);
-    let (mut sum, mut sum2) = (0.0f64, 0.0f64);
-    for (code, &c) in counts.iter().enumerate().filter(|(_, c)| **c > 0) {
+    let (lo, hi) = (map.to_real(code_min as f64), map.to_real(code_max as f64));
+    let (min, max) = (lo.min(hi), lo.max(hi));
+    let width = (max - min).max(f64::MIN_POSITIVE);
+    let targets = [0.01, 0.5, 0.99].map(|q: f64| (q * total as f64).ceil().max(1.0) as u64);
+    let mut percentiles = [map.to_real(code_max as f64); 3];
+    let mut bins = vec![0u64; HISTOGRAM_BINS];
+    let (mut sum, mut sum2, mut acc) = (0.0f64, 0.0f64, 0u64);
+    for (code, &c) in counts.iter().enumerate().take(code_max + 1).skip(code_min) {
+        if c == 0 {
+            continue;
+        }
         let v = map.to_real(code as f64);
         sum += v * c as f64;
         sum2 += v * v * c as f64;
-    }
-    let n = total.max(1) as f64;
-    let mean = sum / n;
-    let std_dev = (sum2 / n - mean * mean).max(0.0).sqrt();
-    let percentile = |q: f64| {
-        let target = (q * total as f64).ceil().max(1.0) as u64;
-        let mut acc = 0;
-        for (code, &c) in counts.iter().enumerate() {
-            acc += c;
-            if acc >= target {
-                return map.to_real(code as f64);
+        for (p, &t) in percentiles.iter_mut().zip(&targets) {
+            if acc < t && acc + c >= t {
+                *p = v;
             }
         }
-        map.to_real(code_max as f64)
-    };
-    let (lo, hi) = (map.to_real(code_min as f64), map.to_real(code_max as f64));
-    let (min, max) = (lo.min(hi), lo.max(hi));
-    let mut bins = vec![0u64; HISTOGRAM_BINS];
-    let width = (max - min).max(f64::MIN_POSITIVE);
-    for (code, &c) in counts.iter().enumerate().filter(|(_, c)| **c > 0) {
-        let v = map.to_real(code as f64);
+        acc += c;
         let b = (((v - min) / width) * HISTOGRAM_BINS as f64) as usize;
         bins[b.min(HISTOGRAM_BINS - 1)] += c;
     }
+    let n = total.max(1) as f64;
+    let mean = sum / n;
     ValueStats {
         code_min: code_min as u16,
         code_max: code_max as u16,
         min,
         max,
         mean,
-        std_dev,
-        p01: percentile(0.01),
-        median: percentile(0.5),
-        p99: percentile(0.99),
+        std_dev: (sum2 / n - mean * mean).max(0.0).sqrt(),
+        p01: percentiles[0],
+        median: percentiles[1],
+        p99: percentiles[2],
         above_min: total - counts.get(code_min).copied().unwrap_or(0),
         histogram: Histogram { min, max, counts: bins },
     }

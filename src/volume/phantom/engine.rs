@@ -71,7 +71,7 @@ pub fn generate(n: u32) -> Result<Volume, String> {
     let n = n.max(8);
     let h = FIELD_OF_VIEW / n as f32;
     let grid = Grid::centered(UVec3::new(n, n, (n / 2).max(4)), Vec3::splat(h));
-    let painted = paint(grid.dims, h, 1.0, grid.origin, AIR, &layers(), |i, v| if v > 5.0 { v + 3.0 * hash_noise(i, 7) } else { v });
+    let painted = paint(grid.dims, h, 2.0, grid.origin, AIR, &layers(), |i, v| if v > 5.0 { v + 3.0 * hash_noise(i, 7) } else { v });
     let codes = painted.values.iter().map(|&v| v.round().clamp(0.0, 255.0) as u8).collect();
     let source = Source {
         format: "phantom".into(),

@@ -145,7 +145,7 @@ pub fn generate(n: u32) -> Result<HeadPhantom, String> {
     let h = FIELD_OF_VIEW / n as f32;
     let grid = Grid::centered(UVec3::splat(n), Vec3::splat(h));
     let layers = layers();
-    let painted = paint(grid.dims, h, 1.0, grid.origin, -1000.0, &layers, |i, v| if v > -500.0 { v + 6.0 * hash_noise(i, 11) } else { v });
+    let painted = paint(grid.dims, h, 3.0, grid.origin, -1000.0, &layers, |i, v| if v > -500.0 { v + 6.0 * hash_noise(i, 11) } else { v });
     let codes: Vec<u16> = painted.values.iter().map(|&hu| (hu + 1024.0).round().clamp(0.0, 4095.0) as u16).collect();
     let source =
         Source { format: "phantom".into(), path: None, sample_type: "int16".into(), details: vec![("phantom".into(), "CT head".into())] };

@@ -3,9 +3,10 @@
 //! A phantom is a list of [`Layer`]s painted in order over a background. Each layer has
 //! a shape with a signed distance `d(p)` (negative inside, in millimetres), a value and a
 //! label. Painting uses partial-volume coverage `w = clamp(0.5 − d / (e·h), 0, 1)` with
-//! `h` the voxel size and `e` the edge width in voxels (1 for the phantoms: a one-voxel
-//! anti-aliased edge), so the value-0.5 iso-surface of a boundary sits on the analytic
-//! surface.
+//! `h` the voxel size and `e` the edge width in voxels, so the value-0.5 iso-surface of
+//! a boundary sits on the analytic surface. The phantoms use two-voxel edges, like the
+//! point-spread function of a scanner: a one-voxel edge is a staircase whose gradient
+//! normals draw contour rings on smooth curved surfaces.
 //! Rows of voxels only test the layers whose bounding boxes they cross.
 
 use glam::{UVec3, Vec3};
@@ -152,8 +153,12 @@ pub fn paint(
             .collect();
         for x in 0..nx {
             let p = Vec3::new(origin.x + x as f32 * h, py, pz);
-            let (mut v, mut l) = (background, 0u8);
-            for &i in &active {
+            // Painting in order is v ← v + (L − v)·w per layer. Walking the layers from the
+            // last, each contributes `remaining·w·L` and leaves `remaining·(1 − w)` to those
+            // below, so the walk stops at the first fully covering layer: the same value,
+            // without evaluating the shapes hidden under it.
+            let (mut v, mut remaining, mut l) = (0.0f32, 1.0f32, None);
+            for &i in active.iter().rev() {
                 let (lo, hi) = bounds[i];
                 if p.x < lo.x || p.x > hi.x {
                     continue;
@@ -161,14 +166,18 @@ pub fn paint(
                 let layer = &layers[i];
                 let w = (0.5 - layer.shape.distance(p) / ramp).clamp(0.0, 1.0);
                 if w > 0.0 {
-                    v += (layer.value - v) * w;
-                    if w >= 0.5 {
-                        l = layer.label;
+                    v += remaining * w * layer.value;
+                    remaining *= 1.0 - w;
+                    if w >= 0.5 && l.is_none() {
+                        l = Some(layer.label);
+                    }
+                    if remaining <= 0.0 {
+                        break;
                     }
                 }
             }
-            vals[x] = noise(row * nx + x, v);
-            labs[x] = l;
+            vals[x] = noise(row * nx + x, v + remaining * background);
+            labs[x] = l.unwrap_or(0);
         }
     });
     Painted { values, labels }

@@ -118,7 +118,8 @@ pub fn decoder<'a>(reader: impl Read + 'a, compression: Compression) -> Box<dyn 
 /// more than the data actually present; fewer bytes is a truncation error, a decoder
 /// failure is reported as corrupt data.
 pub fn read_exact_bounded(reader: impl Read, len: usize) -> Result<Vec<u8>, Problem> {
-    let mut out = Vec::new();
+    // Reserve up front only what no corrupt header can turn into a large waste.
+    let mut out = Vec::with_capacity(len.min(64 << 20));
     match reader.take(len as u64).read_to_end(&mut out) {
         Ok(_) if out.len() == len => Ok(out),
         Ok(_) => Err(Problem::Truncated(format!("expected {len} bytes of voxel data, found {}", out.len()))),
@@ -150,6 +151,14 @@ pub fn inflate_zlib(block: &[u8], len: usize) -> Result<Vec<u8>, Problem> {
     read_exact_bounded(decoder(block, Compression::Zlib), len)
 }
 
+/// Buffer size of file readers: large reads keep system calls few.
+pub const READ_BUFFER: usize = 1 << 20;
+
+/// Opens a file for buffered reading.
+pub fn open_buffered(path: &Path) -> Result<std::io::BufReader<File>, ReadError> {
+    Ok(std::io::BufReader::with_capacity(READ_BUFFER, open(path)?))
+}
+
 /// Opens a file, mapping failure to a [`ReadError`].
 pub fn open(path: &Path) -> Result<File, ReadError> {
     File::open(path).map_err(|e| ReadError::new(path, Problem::Io(e)))
@@ -171,7 +180,7 @@ pub fn read_text(path: &Path, max: u64) -> Result<String, ReadError> {
 }
 
 /// Turns decoded sample bytes into voxel codes.
-pub fn encode(bytes: &[u8], ty: SampleType, order: ByteOrder) -> Result<Encoded, Problem> {
+pub fn encode(bytes: Vec<u8>, ty: SampleType, order: ByteOrder) -> Result<Encoded, Problem> {
     encode_samples(bytes, ty, order).map_err(Problem::Values)
 }
 

@@ -9,13 +9,13 @@
 //! `ElementDataFile` as `LOCAL`, a file name, `LIST` or a `%d` pattern. Positions are
 //! in ITK's LPS space and are flipped into Focal's RAS world.
 
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Vec3};
 
 use super::common::{
-    Compression, Problem, ReadError, ReadOptions, decoder, encode, file_len, first_component, open, parse_numbers, pattern_files,
+    Compression, Problem, ReadError, ReadOptions, decoder, encode, file_len, first_component, open_buffered, parse_numbers, pattern_files,
     read_exact_bounded, skip,
 };
 use super::nifti::volume_name;
@@ -95,7 +95,7 @@ fn sample_type(name: &str) -> Result<SampleType, Problem> {
 /// Reads a MetaImage file.
 pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
     let fail = |p: Problem| ReadError::new(path, p);
-    let mut reader = BufReader::new(open(path)?);
+    let mut reader = open_buffered(path)?;
     let h = parse_header(&mut reader).map_err(fail)?;
     if let Some(t) = h.get("ObjectType")
         && !t.eq_ignore_ascii_case("Image")
@@ -169,16 +169,16 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
         let chunk = match f {
             None => read_stream(path, &mut reader, compressed, binary, header_size, want, ty)?,
             Some(p) => {
-                let mut r = BufReader::new(open(p)?);
+                let mut r = open_buffered(p)?;
                 let skip_bytes =
                     if header_size == -1 && !compressed { file_len(p)?.saturating_sub(want as u64) as i64 } else { header_size };
                 read_stream(p, &mut r, compressed, binary, skip_bytes, want, ty)?
             }
         };
-        bytes.extend_from_slice(&chunk);
+        if bytes.is_empty() { bytes = chunk } else { bytes.extend_from_slice(&chunk) }
     }
     let encoded = if binary {
-        encode(&bytes, ty, order).map_err(fail)?
+        encode(bytes, ty, order).map_err(fail)?
     } else {
         let values: Vec<f64> = parse_numbers("ASCII data", &String::from_utf8_lossy(&bytes)).map_err(fail)?;
         let n = len / ty.size();

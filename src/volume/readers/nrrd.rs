@@ -9,14 +9,14 @@
 //! generic 3D spaces are taken as they are. A 4-D file whose first axis is not spatial
 //! (a vector or list) shows its first component.
 
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Vec3};
 
 use super::common::{
-    Compression, Problem, ReadError, ReadOptions, decoder, encode, file_len, finite, first_component, open, parse_n, parse_numbers,
-    pattern_files, read_exact_bounded, skip,
+    Compression, Problem, ReadError, ReadOptions, decoder, encode, file_len, finite, first_component, open, open_buffered, parse_n,
+    parse_numbers, pattern_files, read_exact_bounded, skip,
 };
 use super::nifti::volume_name;
 use crate::volume::encode::{ByteOrder, SampleType, encode_values};
@@ -134,7 +134,7 @@ fn parse_vectors(field: &str, text: &str) -> Result<Vec<Option<Vec3>>, Problem> 
 /// Reads a NRRD file.
 pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
     let fail = |p: Problem| ReadError::new(path, p);
-    let mut reader = BufReader::new(open(path)?);
+    let mut reader = open_buffered(path)?;
     let header = parse_header(&mut reader).map_err(fail)?;
 
     let ty = sample_type(header.require("type").map_err(fail)?).map_err(fail)?;
@@ -193,14 +193,14 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
     let samples = match encoding.as_str() {
         "raw" | "gzip" | "gz" => {
             let compression = if encoding == "raw" { Compression::None } else { Compression::Gzip };
-            let mut data = Vec::with_capacity(0);
             let per_file = len / files.len().max(1);
+            let mut data = Vec::new();
             for (i, file) in files.iter().enumerate() {
                 let want = if i + 1 == files.len() { len - per_file * i } else { per_file };
                 let chunk = read_chunk(path, file.as_deref(), &mut reader, compression, line_skip, byte_skip, want)?;
-                data.extend_from_slice(&chunk);
+                if data.is_empty() { data = chunk } else { data.extend_from_slice(&chunk) }
             }
-            encode(&data, ty, order).map_err(fail)?
+            encode(data, ty, order).map_err(fail)?
         }
         "ascii" | "text" | "txt" | "hex" => {
             let mut text = String::new();
@@ -307,7 +307,7 @@ fn read_chunk(
     let mut own;
     let stream: &mut dyn Read = match file {
         Some(f) => {
-            own = BufReader::new(open(f)?);
+            own = open_buffered(f)?;
             &mut own
         }
         None => attached,
@@ -334,7 +334,7 @@ fn read_chunk(
         if total < len as u64 {
             return Err(fail(Problem::Truncated(format!("file has {total} bytes, {len} needed"))));
         }
-        let mut data = BufReader::new(open(f)?);
+        let mut data = open_buffered(f)?;
         skip(&mut data, total - len as u64).map_err(fail)?;
         return read_exact_bounded(data, len).map_err(fail);
     }
@@ -356,7 +356,7 @@ fn hex_values(text: &str, ty: SampleType, order: ByteOrder) -> Result<Vec<f64>, 
         })
         .collect();
     let size = ty.size();
-    let enc = crate::volume::encode::encode_samples(&bytes[..bytes.len() / size * size], ty, order).map_err(Problem::Values)?;
+    let enc = crate::volume::encode::encode_samples(bytes[..bytes.len() / size * size].to_vec(), ty, order).map_err(Problem::Values)?;
     Ok((0..enc.voxels.len()).map(|i| enc.map.to_real(enc.voxels.code(i) as f64)).collect())
 }
 

@@ -5,12 +5,11 @@
 //! example `256x256x128:uint8` or `512x512x300:int16:be:s=0.5x0.5x1:skip=1024`. A skip
 //! of `-1` reads the data from the end of the file (a header of unknown size before it).
 
-use std::io::BufReader;
 use std::path::Path;
 
 use glam::{UVec3, Vec3};
 
-use super::common::{Compression, Problem, ReadError, ReadOptions, decoder, encode, file_len, open, read_exact_bounded, skip};
+use super::common::{Compression, Problem, ReadError, ReadOptions, decoder, encode, file_len, open_buffered, read_exact_bounded, skip};
 use super::nifti::volume_name;
 use crate::volume::encode::{ByteOrder, SampleType};
 use crate::volume::{Grid, Source, Volume};
@@ -108,10 +107,10 @@ pub fn read_as(
     } else if skip_bytes < 0 {
         return Err(fail(Problem::Malformed("skip -1 needs an uncompressed file".into())));
     }
-    let mut stream = decoder(BufReader::new(open(path)?), if gz { Compression::Gzip } else { Compression::None });
+    let mut stream = decoder(open_buffered(path)?, if gz { Compression::Gzip } else { Compression::None });
     skip(&mut stream, skip_bytes as u64).map_err(fail)?;
     let bytes = read_exact_bounded(stream, len).map_err(fail)?;
-    let encoded = encode(&bytes, spec.sample, spec.order).map_err(fail)?;
+    let encoded = encode(bytes, spec.sample, spec.order).map_err(fail)?;
     let spacing = spec.spacing;
     if !spacing.is_finite() || spacing.min_element() <= 0.0 {
         return Err(fail(Problem::Malformed(format!("spacing {spacing} is not positive"))));

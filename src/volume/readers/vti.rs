@@ -273,7 +273,7 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
         let values: Vec<f64> = parse_numbers("ascii DataArray", &String::from_utf8_lossy(&data)).map_err(fail)?;
         encode_values(&values, ty).map_err(|e| fail(Problem::Values(e)))?
     } else {
-        encode(&data, ty, order).map_err(fail)?
+        encode(data, ty, order).map_err(fail)?
     };
     let encoded = if components > 1 { first_component(encoded, components) } else { encoded };
 

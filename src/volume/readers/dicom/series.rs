@@ -249,12 +249,12 @@ fn assemble(
     let ty = format.sample_type();
     let uniform = planes.iter().all(|p| p.geometry.slope == g0.slope && p.geometry.intercept == g0.intercept);
     let encoded = if uniform {
-        let mut e = encode_samples(&bytes, ty, ByteOrder::Little).map_err(|e| fail(Problem::Values(e)))?;
+        let mut e = encode_samples(bytes, ty, ByteOrder::Little).map_err(|e| fail(Problem::Values(e)))?;
         e.map = e.map.then(g0.slope, g0.intercept);
         e
     } else {
         // Rescale differs per frame: apply it to every value, then quantise once.
-        let raw = encode_samples(&bytes, ty, ByteOrder::Little).map_err(|e| fail(Problem::Values(e)))?;
+        let raw = encode_samples(bytes, ty, ByteOrder::Little).map_err(|e| fail(Problem::Values(e)))?;
         let per = format.rows as usize * format.cols as usize;
         let real: Vec<f64> = (0..raw.voxels.len())
             .map(|i| {
