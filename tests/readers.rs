@@ -218,6 +218,8 @@ fn aal_labels_with_names_and_colours() {
     // Colours come from aal.nii.lut (planar R, G, B).
     let lut = std::fs::read(data("labels/aal.nii.lut")).unwrap();
     assert_eq!(labels.table.color(1), [lut[1], lut[257], lut[513]]);
+    // The palette colours the named labels; it does not add 139 unnamed ones.
+    assert_eq!(labels.table.len(), 116);
     assert_eq!(labels.id(60, 54, 36), 91);
     let table = label_table::read(&data("labels/aal.nii.txt")).unwrap();
     assert_eq!(table.len(), 116);

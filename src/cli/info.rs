@@ -87,7 +87,7 @@ fn report(v: &Volume, labels: Option<&LabelVolume>) -> Value {
 
 fn print_text(r: &Value) {
     let f = |v: &Value| match v {
-        Value::Number(n) => n.as_f64().map(|x| if x.fract() == 0.0 { format!("{x}") } else { format!("{x:.4}") }).unwrap_or_default(),
+        Value::Number(_) => f_num(v),
         Value::String(s) => s.clone(),
         Value::Array(a) => a
             .iter()
@@ -136,7 +136,11 @@ fn print_text(r: &Value) {
 }
 
 fn f_num(v: &Value) -> String {
-    v.as_f64().map(|x| if x.fract() == 0.0 && x.abs() < 1e15 { format!("{x}") } else { format!("{x:.4}") }).unwrap_or_else(|| v.to_string())
+    let clean = |x: f64| if x.abs() < 5e-5 { 0.0 } else { x };
+    v.as_f64()
+        .map(clean)
+        .map(|x| if x.fract() == 0.0 && x.abs() < 1e15 { format!("{x}") } else { format!("{x:.4}") })
+        .unwrap_or_else(|| v.to_string())
 }
 
 /// 32-character log-scaled sparkline of a histogram.

@@ -102,10 +102,16 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     // Frame what the transfer function shows (the whole box for projections and labels).
     let visible = match (&scene.appearances[0].lookup, args.mode.is_projection()) {
         (Lookup::Transfer(tf), false) => Lut::for_volume(tf, target).visible_bounds(target),
+        (Lookup::Labels(styles), _) => {
+            let table = styles.bake(target.stats.code_max as usize + 1);
+            let bricks = target.bricks();
+            let keep = bricks.occupancy(|lo, hi| table[lo as usize..=hi as usize].iter().any(|c| c[3] > 0.0));
+            bricks.bounds_where(&keep).map(|(lo, hi)| target.grid.index_box_world_bounds(lo, hi))
+        }
         _ => None,
     };
     let (lo, hi) = visible.unwrap_or_else(|| target.grid.world_bounds());
-    let camera = args.view.frame((lo + hi) * 0.5, (hi - lo).length() * 0.5, args.ortho);
+    let camera = args.view.frame_box(lo, hi, w as f32 / h as f32, args.ortho);
     let t = Instant::now();
     let image = render(&scene, &camera, w, h)?;
     eprintln!("rendered {w}×{h} in {:.2} s", t.elapsed().as_secs_f32());

@@ -137,6 +137,34 @@ impl View {
     }
 }
 
+impl View {
+    /// A camera from this side that fits the box `[lo, hi]` tightly into a view of the
+    /// given aspect ratio (width / height), with a small margin.
+    pub fn frame_box(self, lo: Vec3, hi: Vec3, aspect: f32, orthographic: bool) -> Camera {
+        let (dir, up) = self.direction_and_up();
+        let center = (lo + hi) * 0.5;
+        let probe = Camera::look_at(center + dir, center, up, Projection::Orthographic { height: 1.0 });
+        let (right, up, back) = (probe.right(), probe.up(), dir);
+        let corners = (0..8).map(|c| {
+            Vec3::new(if c & 1 == 0 { lo.x } else { hi.x }, if c & 2 == 0 { lo.y } else { hi.y }, if c & 4 == 0 { lo.z } else { hi.z })
+                - center
+        });
+        let margin = 1.05;
+        let aspect = aspect.max(1e-3);
+        if orthographic {
+            let half = corners.fold(0.0f32, |m, c| m.max(c.dot(up).abs()).max(c.dot(right).abs() / aspect));
+            let depth = (hi - lo).length();
+            return Camera::look_at(center + dir * depth, center, probe.up(), Projection::Orthographic { height: 2.0 * half * margin });
+        }
+        let fov_y = 30f32.to_radians();
+        let tan = (fov_y * 0.5).tan() / margin;
+        // Every corner c must satisfy |c·up| ≤ (D − c·back)·tan and |c·right| ≤ (D − c·back)·tan·aspect.
+        let distance =
+            corners.fold(0.0f32, |d, c| d.max(c.dot(back) + c.dot(up).abs() / tan).max(c.dot(back) + c.dot(right).abs() / (tan * aspect)));
+        Camera::look_at(center + dir * distance, center, probe.up(), Projection::Perspective { fov_y })
+    }
+}
+
 impl std::str::FromStr for View {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
@@ -187,5 +215,34 @@ mod tests {
             assert!(d > 10.0, "{v:?} {d}");
         }
         assert_eq!("top".parse::<View>().unwrap(), View::Superior);
+        // A tight box fit: every corner projects inside the image, one touches the margin.
+        let (lo, hi) = (Vec3::new(-10.0, -4.0, -2.0), Vec3::new(10.0, 4.0, 2.0));
+        for ortho in [false, true] {
+            let cam = View::Oblique.frame_box(lo, hi, 1.5, ortho);
+            let mut widest = 0.0f32;
+            for c in 0..8 {
+                let p = Vec3::new(
+                    if c & 1 == 0 { lo.x } else { hi.x },
+                    if c & 2 == 0 { lo.y } else { hi.y },
+                    if c & 4 == 0 { lo.z } else { hi.z },
+                );
+                let (x, y) = project(&cam, p, 1.5);
+                assert!(x.abs() <= 1.0 && y.abs() <= 1.0, "{ortho} {x} {y}");
+                widest = widest.max(x.abs()).max(y.abs());
+            }
+            assert!(widest > 0.9, "{ortho}: {widest}");
+        }
+    }
+
+    /// Normalised device coordinates of a world point.
+    fn project(cam: &Camera, p: Vec3, aspect: f32) -> (f32, f32) {
+        let q = cam.rotation.inverse() * (p - cam.position);
+        match cam.projection {
+            Projection::Perspective { fov_y } => {
+                let k = (fov_y * 0.5).tan();
+                (q.x / (-q.z * k * aspect), q.y / (-q.z * k))
+            }
+            Projection::Orthographic { height } => (q.x / (height * 0.5 * aspect), q.y / (height * 0.5)),
+        }
     }
 }

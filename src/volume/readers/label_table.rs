@@ -80,8 +80,14 @@ pub fn read_sidecars(volume: &Path) -> Result<LabelTable, ReadError> {
     for p in sidecars(volume, &["lut"]) {
         if p.is_file() {
             let colors = read(&p)?;
-            for (id, l) in colors.labels {
-                table.labels.entry(id).and_modify(|e| e.color = l.color).or_insert(l);
+            if table.is_empty() {
+                table = colors;
+            } else {
+                for (id, l) in colors.labels {
+                    if let Some(e) = table.labels.get_mut(&id) {
+                        e.color = l.color;
+                    }
+                }
             }
             break;
         }
