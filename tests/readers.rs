@@ -381,3 +381,22 @@ fn unknown_files_are_named() {
     let e = read_volume(&dir.join("nan.mha"), &ReadOptions::default()).unwrap_err();
     assert!(e.to_string().contains("NaN"), "{e}");
 }
+
+#[test]
+fn metaimage_uncompressed_with_a_data_file() {
+    // The epi volume re-saved as an uncompressed .mhd + .raw pair, big-endian.
+    let src = read("mri/epi_64x64x37.mha");
+    let dir = scratch("mhd");
+    let raw: Vec<u8> = (0..src.voxels.len()).flat_map(|i| (src.values.to_real(src.voxels.code(i) as f64) as i16).to_be_bytes()).collect();
+    std::fs::write(dir.join("epi.raw"), raw).unwrap();
+    std::fs::write(
+        dir.join("epi.mhd"),
+        "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = True\nCompressedData = False\n\
+         TransformMatrix = 1 0 0 0 -1 0 0 0 1\nOffset = -108.281 82.3795 -47.8356\nElementSpacing = 3.4375 3.4375 3.8\n\
+         DimSize = 64 64 37\nElementType = MET_SHORT\nElementDataFile = epi.raw\n",
+    )
+    .unwrap();
+    let v = read_volume(&dir.join("epi.mhd"), &ReadOptions::default()).unwrap();
+    assert_eq!(v.voxels, src.voxels);
+    assert_eq!(v.grid, src.grid);
+}

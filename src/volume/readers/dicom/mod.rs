@@ -232,3 +232,23 @@ fn pixel_bytes<'a>(object: &'a DefaultDicomObject, format: &PixelFormat, frames:
         }
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_are_masked_and_sign_extended() {
+        // 12 bits stored in 16: 0x0FFF is −1 when signed; bits above 12 are garbage.
+        let f = PixelFormat { rows: 1, cols: 3, bits_allocated: 16, bits_stored: 12, signed: true };
+        let mut b: Vec<u8> = [0xFFFFu16, 0xF800, 0x07FF].iter().flat_map(|v| v.to_le_bytes()).collect();
+        f.normalise(&mut b);
+        let v: Vec<i16> = b.chunks_exact(2).map(|c| i16::from_le_bytes([c[0], c[1]])).collect();
+        assert_eq!(v, vec![-1, -2048, 2047]);
+        let u = PixelFormat { signed: false, ..f };
+        let mut b: Vec<u8> = [0xF0FFu16].iter().flat_map(|v| v.to_le_bytes()).collect();
+        u.normalise(&mut b);
+        assert_eq!(u16::from_le_bytes([b[0], b[1]]), 0x00FF);
+        assert_eq!(u.sample_type(), crate::volume::SampleType::U16);
+    }
+}
