@@ -6,13 +6,15 @@ use std::path::Path;
 use glam::Vec4;
 
 use super::trace::Traced;
+use crate::transfer::color::linear_to_srgb;
 
 /// A rendered image with its per-pixel by-products.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderedImage {
     pub width: u32,
     pub height: u32,
-    /// Final colour (composited over the background), row-major from the top.
+    /// Final colour in linear light (composited over the background), row-major from the
+    /// top.
     pub rgba: Vec<Vec4>,
     /// Accumulated opacity of the volume alone.
     pub alpha: Vec<f32>,
@@ -42,9 +44,10 @@ impl RenderedImage {
         self.rgba[(y * self.width + x) as usize]
     }
 
-    /// 8-bit RGBA bytes (display values, rounded).
+    /// 8-bit sRGB-encoded RGBA bytes (alpha linear), rounded.
     pub fn to_rgba8(&self) -> Vec<u8> {
-        self.rgba.iter().flat_map(|c| c.to_array().map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)).collect()
+        let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+        self.rgba.iter().flat_map(|c| [q(linear_to_srgb(c.x)), q(linear_to_srgb(c.y)), q(linear_to_srgb(c.z)), q(c.w)]).collect()
     }
 
     /// Writes a PNG.

@@ -28,7 +28,7 @@ pub struct RenderScene<'a> {
     pub volumes: Vec<&'a Volume>,
     pub regions: Vec<Region>,
     pub appearances: Vec<Appearance>,
-    /// Background colour (display values, premultiplied not needed: alpha 1).
+    /// Background colour (display sRGB values).
     pub background: [f32; 3],
     pub light: Light,
     /// Jitter ray starts per pixel (against wood-grain artefacts).
@@ -77,7 +77,8 @@ pub fn render(scene: &RenderScene, camera: &Camera, width: u32, height: u32) -> 
         return Err(format!("image size {width}×{height} is empty"));
     }
     let regions = scene.prepare()?;
-    let bg = Vec4::new(scene.background[0], scene.background[1], scene.background[2], 1.0);
+    let [r, g, b] = crate::transfer::color::srgb3_to_linear(scene.background);
+    let bg = Vec4::new(r, g, b, 1.0);
     let pixels: Vec<Traced> = (0..height)
         .into_par_iter()
         .flat_map_iter(|y| {

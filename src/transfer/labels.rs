@@ -5,6 +5,7 @@
 
 use std::collections::BTreeMap;
 
+use super::color::srgb3_to_linear;
 use crate::volume::LabelTable;
 
 /// How one label is drawn.
@@ -37,12 +38,14 @@ impl LabelTransfer {
         Self { styles, default_opacity: 0.0 }
     }
 
-    /// RGBA per id `0..len` (hidden labels get opacity 0).
+    /// RGBA per id `0..len`, colour in linear light (hidden labels get opacity 0).
     pub fn bake(&self, len: usize) -> Vec<[f32; 4]> {
         (0..len as u32)
             .map(|id| match self.styles.get(&id) {
-                Some(s) if s.visible => [s.color[0], s.color[1], s.color[2], s.opacity],
-                Some(s) => [s.color[0], s.color[1], s.color[2], 0.0],
+                Some(s) => {
+                    let c = srgb3_to_linear(s.color);
+                    [c[0], c[1], c[2], if s.visible { s.opacity } else { 0.0 }]
+                }
                 None => [1.0, 1.0, 1.0, self.default_opacity],
             })
             .collect()
@@ -59,7 +62,7 @@ mod tests {
         let mut table = LabelTable::default();
         table.labels.insert(2, Label { name: "b".into(), color: [255, 0, 0] });
         let mut t = LabelTransfer::from_table(&table, [0, 2, 3], 0.5);
-        assert_eq!(t.bake(4)[2], [1.0, 0.0, 0.0, 0.5]);
+        assert_eq!(t.bake(4)[2], [1.0, 0.0, 0.0, 0.5]); // pure red is red in both spaces
         assert_eq!(t.bake(4)[0][3], 0.0);
         assert_eq!(t.bake(4)[1], [1.0, 1.0, 1.0, 0.0]);
         t.styles.get_mut(&2).unwrap().visible = false;

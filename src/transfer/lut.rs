@@ -8,6 +8,7 @@
 //! linear filtering with clamp-to-edge. The shader gets the texture coordinate of a
 //! normalised volume sample `t` from one affine map `u = a·t + b` ([`Lut::texcoord_map`]).
 
+use super::color::srgb3_to_linear;
 use super::function::TransferFunction;
 use crate::volume::Volume;
 
@@ -15,7 +16,7 @@ use crate::volume::Volume;
 pub const LUT_SIZE_8: usize = 256;
 pub const LUT_SIZE_16: usize = 4096;
 
-/// A baked RGBA table (colour not premultiplied; alpha per reference length).
+/// A baked RGBA table (linear colour, not premultiplied; alpha per reference length).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Lut {
     pub rgba: Vec<[f32; 4]>,
@@ -32,7 +33,7 @@ impl Lut {
         let rgba = (0..n)
             .map(|i| {
                 let v = lo + (i as f64 + 0.5) / n as f64 * (hi - lo);
-                let c = tf.color_at(v);
+                let c = srgb3_to_linear(tf.color_at(v));
                 [c[0], c[1], c[2], tf.opacity_at(v)]
             })
             .collect();
