@@ -13,6 +13,8 @@ use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use flate2::read::{GzDecoder, ZlibDecoder};
+use std::sync::Arc;
+
 use focal::reference::{RenderScene, render};
 use focal::region::{Appearance, Mode, View};
 use focal::transfer::presets;
@@ -122,7 +124,7 @@ fn bricks(c: &mut Criterion) {
 fn reference(c: &mut Criterion) {
     let Ok(v) = Phantom::Head.generate(128) else { return };
     let Ok(tf) = presets::builtin("ct_skin_bone") else { return };
-    let scene = RenderScene::single(&v, Appearance::new(Mode::Dvr, tf));
+    let scene = RenderScene::single(Arc::new(v.clone()), Appearance::new(Mode::Dvr, tf));
     let (lo, hi) = v.grid.world_bounds();
     let camera = View::Oblique.frame((lo + hi) * 0.5, (hi - lo).length() * 0.5, false);
     let samples = render(&scene, &camera, 128, 128).map(|i| i.samples).unwrap_or(0);

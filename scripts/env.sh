@@ -5,8 +5,9 @@ set -euo pipefail
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/focal-target}"
 export CARGO_TERM_COLOR="${CARGO_TERM_COLOR:-never}"
 
-# Debian packages needed at run time (added as the GPU renderer and the app arrive).
-FOCAL_PACKAGES=()
+# Debian packages needed at run time: software Vulkan (lavapipe) for headless GPU
+# rendering where there is no GPU.
+FOCAL_PACKAGES=(mesa-vulkan-drivers)
 
 ensure_packages() {
   local missing=()
@@ -23,3 +24,6 @@ ensure_packages() {
 
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 ensure_packages
+
+# wgpu: Vulkan (its GL backend panics on these machines).
+export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"

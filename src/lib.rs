@@ -3,9 +3,34 @@
 //! The crate is organised by technique (see `../shared/DESIGN.md` and the README):
 //! [`volume`] holds the data model, readers and phantoms; [`transfer`] the transfer
 //! functions; [`region`] the geometry every renderer shares; [`reference`] the CPU
-//! reference renderer. Techniques and the GPU renderer build on these.
+//! reference renderer; [`dataset`] the dataset entities that become regions; [`render`]
+//! the GPU ray caster that packs and draws them; [`scene`] scene files.
 
+pub mod dataset;
 pub mod reference;
 pub mod region;
+pub mod render;
+pub mod scene;
 pub mod transfer;
 pub mod volume;
+
+use bevy::app::{PluginGroup, PluginGroupBuilder};
+
+/// Everything that needs no GPU: datasets, regions, scenes (for headless ECS tests
+/// with `MinimalPlugins`).
+pub struct FocalCorePlugins;
+
+impl PluginGroup for FocalCorePlugins {
+    fn build(self) -> PluginGroupBuilder {
+        PluginGroupBuilder::start::<Self>().add(dataset::DatasetPlugin)
+    }
+}
+
+/// Everything: the core plus the GPU ray caster. Add after Bevy's `DefaultPlugins`.
+pub struct FocalPlugins;
+
+impl PluginGroup for FocalPlugins {
+    fn build(self) -> PluginGroupBuilder {
+        FocalCorePlugins.build().add(render::VolumeRenderPlugin)
+    }
+}

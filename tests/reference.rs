@@ -3,6 +3,8 @@
 //! against its analytic radius, picking, clipping, gradient modulation and the
 //! invariance of the image to empty-space skipping and (nearly) to the step size.
 
+use std::sync::Arc;
+
 use focal::reference::{RenderScene, pick, render};
 use focal::region::{Appearance, Camera, Lookup, Mode, Plane, Projection, Region, View};
 use focal::transfer::color::linear_to_srgb;
@@ -48,7 +50,7 @@ fn projection_matches(mode: Mode, sixteen: bool, reduce: impl Fn(&[f32]) -> f32)
     let v = noise_volume(dims, sixteen);
     let mut a = Appearance::new(mode, opaque_ramp());
     a.step = 1.0;
-    let scene = RenderScene::single(&v, a);
+    let scene = RenderScene::single(Arc::new(v.clone()), a);
     let img = render(&scene, &top_camera(dims), dims.x, dims.y).unwrap();
     let code_max = v.code_max() as f32;
     let (lo, hi) = (v.stats.min as f32, v.stats.max as f32);
@@ -92,7 +94,7 @@ fn iso_hit_radii(camera: &Camera, size: u32) -> Vec<f32> {
     let mut a = Appearance::new(Mode::Iso, opaque_ramp());
     a.iso_value = 127.5; // normalised 0.5
     a.step = 0.5;
-    let scene = RenderScene::single(&v, a);
+    let scene = RenderScene::single(Arc::new(v.clone()), a);
     let img = render(&scene, camera, size, size).unwrap();
     let mut radii = Vec::new();
     for py in 0..size {
@@ -126,7 +128,7 @@ fn sphere_iso_surface_lies_at_the_analytic_radius() {
 #[test]
 fn picking_finds_the_first_visible_surface() {
     let v = phantom::sphere(64, 20.0).unwrap();
-    let scene = RenderScene::single(&v, Appearance::new(Mode::Dvr, opaque_ramp()));
+    let scene = RenderScene::single(Arc::new(v.clone()), Appearance::new(Mode::Dvr, opaque_ramp()));
     let ray = focal::region::Ray { origin: Vec3::new(-50.0, 0.3, 0.2), dir: Vec3::X };
     let hit = pick(&scene, ray).unwrap().expect("hit");
     // Opacity 1 for any value: the first sample inside the box is already opaque, so
@@ -134,7 +136,7 @@ fn picking_finds_the_first_visible_surface() {
     assert!(hit.position.x < -20.0, "{hit:?}");
     let mut tf = opaque_ramp();
     tf.opacity = vec![OpacityPoint(0.0, 0.0), OpacityPoint(0.49, 0.0), OpacityPoint(0.51, 1.0)];
-    let scene = RenderScene::single(&v, Appearance::new(Mode::Dvr, tf));
+    let scene = RenderScene::single(Arc::new(v.clone()), Appearance::new(Mode::Dvr, tf));
     let hit = pick(&scene, ray).unwrap().expect("hit");
     assert!((hit.position.x + 20.0).abs() < 0.5, "{hit:?}");
     let miss = focal::region::Ray { origin: Vec3::new(-50.0, 40.0, 0.0), dir: Vec3::X };
@@ -147,7 +149,7 @@ fn clip_planes_cut_the_region() {
     let v = noise_volume(dims, false);
     let mut a = Appearance::new(Mode::Mip, opaque_ramp());
     a.step = 1.0;
-    let mut scene = RenderScene::single(&v, a);
+    let mut scene = RenderScene::single(Arc::new(v.clone()), a);
     scene.regions[0] = scene.regions[0].clone().clipped(Plane::through(Vec3::ZERO, Vec3::X));
     let img = render(&scene, &top_camera(dims), dims.x, dims.y).unwrap();
     for px in 0..dims.x {
@@ -162,7 +164,7 @@ fn two_overlapping_regions_composite_sample_by_sample() {
     let v = phantom::sphere(32, 10.0).unwrap();
     let mut tf = opaque_ramp();
     tf.opacity = vec![OpacityPoint(0.0, 0.0), OpacityPoint(1.0, 0.05)];
-    let one = RenderScene::single(&v, Appearance::new(Mode::Dvr, tf.clone()));
+    let one = RenderScene::single(Arc::new(v.clone()), Appearance::new(Mode::Dvr, tf.clone()));
     let mut two = one.clone();
     two.regions.push(Region::volume_box(&v.grid, 0, 0));
     let cam = View::Anterior.frame(Vec3::ZERO, 28.0, true);
@@ -180,7 +182,7 @@ fn two_overlapping_regions_composite_sample_by_sample() {
 fn empty_space_skipping_does_not_change_the_image() {
     let h = Phantom::Head.generate(64).unwrap();
     let tf = presets::builtin("ct_bone").unwrap();
-    let mut scene = RenderScene::single(&h, Appearance::new(Mode::Dvr, tf));
+    let mut scene = RenderScene::single(Arc::new(h.clone()), Appearance::new(Mode::Dvr, tf));
     scene.jitter = true;
     let cam = View::Oblique.frame(h.grid.center(), 130.0, false);
     let skipped = render(&scene, &cam, 48, 48).unwrap();
@@ -198,7 +200,7 @@ fn opacity_correction_keeps_the_image_across_step_sizes() {
     let at = |step: f32| {
         let mut a = Appearance::new(Mode::Dvr, tf.clone());
         a.step = step;
-        render(&RenderScene::single(&h, a), &cam, 40, 40).unwrap()
+        render(&RenderScene::single(Arc::new(h.clone()), a), &cam, 40, 40).unwrap()
     };
     let (fine, coarse) = (at(0.25), at(0.5));
     let diff: f32 = fine.alpha.iter().zip(&coarse.alpha).map(|(a, b)| (a - b).abs()).sum::<f32>() / fine.alpha.len() as f32;
@@ -223,7 +225,8 @@ fn gradient_modulation_hides_homogeneous_interiors() {
     tf.opacity = vec![OpacityPoint(0.0, 0.0), OpacityPoint(0.5, 0.1)];
     let cam =
         Camera { position: Vec3::new(0.0, 0.0, 60.0), rotation: Quat::IDENTITY, projection: Projection::Orthographic { height: 40.0 } };
-    let centre = |mode| render(&RenderScene::single(&v, Appearance::new(mode, tf.clone())), &cam, 9, 9).unwrap().alpha[4 * 9 + 4];
+    let centre =
+        |mode| render(&RenderScene::single(Arc::new(v.clone()), Appearance::new(mode, tf.clone())), &cam, 9, 9).unwrap().alpha[4 * 9 + 4];
     let (dvr, grad) = (centre(Mode::Dvr), centre(Mode::GradientDvr));
     assert!(dvr > 0.9, "{dvr}");
     assert!(grad < 0.5 * dvr && grad > 0.0, "{grad} vs {dvr}");
@@ -238,7 +241,7 @@ fn label_volumes_render_with_their_colours() {
     let skull = phantom::head::label::SKULL as u32;
     styles.styles.get_mut(&skull).unwrap().opacity = 1.0;
     let a = Appearance { lookup: Lookup::Labels(styles), ..Appearance::new(Mode::Dvr, opaque_ramp()) };
-    let scene = RenderScene::single(&head.labels.volume, a);
+    let scene = RenderScene::single(Arc::new(head.labels.volume.clone()), a);
     let cam = View::Anterior.frame(Vec3::ZERO, 130.0, true);
     let img = render(&scene, &cam, 32, 32).unwrap();
     // The centre pixel hits the skull (its colour is near white); corners see nothing.

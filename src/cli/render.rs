@@ -1,11 +1,17 @@
 //! `focal render`: a volume or phantom to PNG with the CPU reference renderer.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
+use bevy::prelude::Transform;
 use clap::Args;
+use focal::FocalPlugins;
+use focal::dataset::Dataset;
 use focal::reference::{RenderScene, render};
 use focal::region::{Appearance, Lookup, Mode, View};
+use focal::render::VolumeView;
+use focal::render::headless::Offscreen;
 use focal::transfer::{LabelTransfer, Lut, presets};
 use focal::volume::readers::RawSpec;
 use focal::volume::{LabelTable, LabelVolume};
@@ -14,7 +20,7 @@ use focal::volume::{LabelTable, LabelVolume};
 pub struct RenderArgs {
     /// Volume file, DICOM folder or `phantom:head|engine|sphere` (default: the head phantom).
     input: Option<PathBuf>,
-    /// Render on the CPU with the reference renderer (the only renderer so far).
+    /// Render on the CPU with the reference renderer instead of the GPU.
     #[arg(long)]
     cpu: bool,
     /// Transfer-function preset name or `.ron` file (default: chosen for the data).
@@ -67,9 +73,6 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
-    if !args.cpu {
-        eprintln!("note: the GPU renderer is not built yet; rendering on the CPU");
-    }
     let (w, h) = parse_size(&args.size)?;
     let t = Instant::now();
     let volume = super::load(args.input.as_deref(), args.raw.as_ref(), args.resolution)?;
@@ -97,10 +100,9 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     appearance.step = args.step;
     appearance.shading.enabled = !args.no_shading;
     appearance.iso_value = args.iso.unwrap_or((target.stats.min + target.stats.max) * 0.5);
-    let mut scene = RenderScene::single(target, appearance);
-    scene.jitter = args.jitter;
-    // Frame what the transfer function shows (the whole box for projections and labels).
-    let visible = match (&scene.appearances[0].lookup, args.mode.is_projection()) {
+    let volume = Arc::new(target.clone());
+    // Frame what the transfer function shows (the whole box for projections).
+    let visible = match (&appearance.lookup, args.mode.is_projection()) {
         (Lookup::Transfer(tf), false) => Lut::for_volume(tf, target).visible_bounds(target),
         (Lookup::Labels(styles), _) => {
             let table = styles.bake(target.stats.code_max as usize + 1);
@@ -113,16 +115,29 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     let (lo, hi) = visible.unwrap_or_else(|| target.grid.world_bounds());
     let camera = args.view.frame_box(lo, hi, w as f32 / h as f32, args.ortho);
     let t = Instant::now();
-    let image = render(&scene, &camera, w, h)?;
+    let image = if args.cpu {
+        let mut scene = RenderScene::single(volume, appearance);
+        scene.jitter = args.jitter;
+        render(&scene, &camera, w, h)?.to_image()?
+    } else {
+        let mut off = Offscreen::new(w, h, |app| {
+            app.add_plugins(FocalPlugins);
+        })?;
+        off.world_mut().spawn((Dataset::new(volume, appearance), Transform::default()));
+        off.set_camera(&camera);
+        off.set_view(VolumeView { jitter: args.jitter, ..Default::default() });
+        eprintln!("GPU: {}", off.adapter_name());
+        off.capture()?
+    };
     eprintln!("rendered {w}×{h} in {:.2} s", t.elapsed().as_secs_f32());
     write(&image, &args.out)
 }
 
-fn write(image: &focal::reference::RenderedImage, out: &Path) -> Result<(), String> {
+fn write(image: &image::RgbaImage, out: &Path) -> Result<(), String> {
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     }
-    image.save_png(out)?;
+    image.save(out).map_err(|e| format!("{}: {e}", out.display()))?;
     println!("{}", out.display());
     Ok(())
 }
@@ -132,7 +147,7 @@ fn write(image: &focal::reference::RenderedImage, out: &Path) -> Result<(), Stri
 pub fn run_default(volume: Option<&Path>, out: &Path) -> Result<(), String> {
     let args = RenderArgs {
         input: volume.map(Path::to_path_buf),
-        cpu: true,
+        cpu: false,
         preset: None,
         mode: Mode::Dvr,
         view: View::Oblique,

@@ -50,9 +50,13 @@ impl RenderedImage {
         self.rgba.iter().flat_map(|c| [q(linear_to_srgb(c.x)), q(linear_to_srgb(c.y)), q(linear_to_srgb(c.z)), q(c.w)]).collect()
     }
 
+    /// The image as sRGB RGBA8.
+    pub fn to_image(&self) -> Result<image::RgbaImage, String> {
+        image::RgbaImage::from_raw(self.width, self.height, self.to_rgba8()).ok_or_else(|| "image buffer has the wrong size".into())
+    }
+
     /// Writes a PNG.
     pub fn save_png(&self, path: &Path) -> Result<(), String> {
-        let img = image::RgbaImage::from_raw(self.width, self.height, self.to_rgba8()).ok_or("image buffer has the wrong size")?;
-        img.save(path).map_err(|e| format!("{}: {e}", path.display()))
+        self.to_image()?.save(path).map_err(|e| format!("{}: {e}", path.display()))
     }
 }

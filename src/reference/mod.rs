@@ -15,60 +15,32 @@ use rayon::prelude::*;
 pub use image::RenderedImage;
 pub use trace::Traced;
 
-use crate::region::{Appearance, Camera, Light, Ray, Region};
-use crate::volume::Volume;
+pub use crate::region::RenderScene;
+use crate::region::{Camera, Ray};
 use prepare::PreparedRegion;
 
 /// Accumulated opacity that defines the depth of a pixel and a pick hit.
 pub const DEPTH_THRESHOLD: f32 = 0.5;
 
-/// What to render: volumes, the regions showing them and their appearances.
-#[derive(Clone, Debug)]
-pub struct RenderScene<'a> {
-    pub volumes: Vec<&'a Volume>,
-    pub regions: Vec<Region>,
-    pub appearances: Vec<Appearance>,
-    /// Background colour (display sRGB values).
-    pub background: [f32; 3],
-    pub light: Light,
-    /// Jitter ray starts per pixel (against wood-grain artefacts).
-    pub jitter: bool,
-    /// Skip bricks the transfer function makes invisible (exact; off only to measure).
-    pub skip_empty: bool,
-}
-
-impl<'a> RenderScene<'a> {
-    /// One volume shown in its own box with one appearance.
-    pub fn single(volume: &'a Volume, appearance: Appearance) -> Self {
-        RenderScene {
-            volumes: vec![volume],
-            regions: vec![Region::volume_box(&volume.grid, 0, 0)],
-            appearances: vec![appearance],
-            background: [0.0; 3],
-            light: Light::Headlight,
-            jitter: false,
-            skip_empty: true,
-        }
-    }
-
-    fn prepare(&self) -> Result<Vec<PreparedRegion<'_>>, String> {
-        self.regions
-            .iter()
-            .map(|r| {
-                let v =
-                    self.volumes.get(r.volume).ok_or_else(|| format!("region refers to volume {} of {}", r.volume, self.volumes.len()))?;
-                let a = self
-                    .appearances
-                    .get(r.appearance)
-                    .ok_or_else(|| format!("region refers to appearance {} of {}", r.appearance, self.appearances.len()))?;
-                let mut p = PreparedRegion::new(r, v, a);
-                if !self.skip_empty {
-                    p.occupancy = None;
-                }
-                Ok(p)
-            })
-            .collect()
-    }
+/// Prepares every region of `scene` (baked lookups, samplers, occupancy).
+pub fn prepare(scene: &RenderScene) -> Result<Vec<PreparedRegion<'_>>, String> {
+    scene
+        .regions
+        .iter()
+        .map(|r| {
+            let v =
+                scene.volumes.get(r.volume).ok_or_else(|| format!("region refers to volume {} of {}", r.volume, scene.volumes.len()))?;
+            let a = scene
+                .appearances
+                .get(r.appearance)
+                .ok_or_else(|| format!("region refers to appearance {} of {}", r.appearance, scene.appearances.len()))?;
+            let mut p = PreparedRegion::new(r, v, a);
+            if !scene.skip_empty {
+                p.occupancy = None;
+            }
+            Ok(p)
+        })
+        .collect()
 }
 
 /// Renders `scene` seen by `camera` into a `width × height` image.
@@ -76,7 +48,7 @@ pub fn render(scene: &RenderScene, camera: &Camera, width: u32, height: u32) -> 
     if width == 0 || height == 0 {
         return Err(format!("image size {width}×{height} is empty"));
     }
-    let regions = scene.prepare()?;
+    let regions = prepare(scene)?;
     let [r, g, b] = crate::transfer::color::srgb3_to_linear(scene.background);
     let bg = Vec4::new(r, g, b, 1.0);
     let pixels: Vec<Traced> = (0..height)
@@ -104,7 +76,7 @@ pub struct Hit {
 
 /// First visible point along `ray` under the scene's transfer functions.
 pub fn pick(scene: &RenderScene, ray: Ray) -> Result<Option<Hit>, String> {
-    let regions = scene.prepare()?;
+    let regions = prepare(scene)?;
     let t = trace::trace(&regions, scene.light, ray, 0.5, DEPTH_THRESHOLD, true);
     Ok(t.region.map(|region| Hit { t: t.depth, position: ray.at(t.depth), region }))
 }

@@ -10,11 +10,13 @@
 
 pub mod appearance;
 pub mod camera;
+pub mod scene;
 
 use glam::{Affine3A, Vec3};
 
 pub use appearance::{Appearance, Light, Lookup, Mode, Shading};
 pub use camera::{Camera, Projection, Ray, View};
+pub use scene::RenderScene;
 
 use crate::volume::Grid;
 

@@ -12,6 +12,7 @@ pub mod grid;
 pub mod labels;
 pub mod phantom;
 pub mod readers;
+pub mod resample;
 pub mod sample;
 pub mod selection;
 pub mod stats;

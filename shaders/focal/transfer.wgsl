@@ -1,0 +1,30 @@
+#define_import_path focal::transfer
+
+// Classification through the lookup-table atlas with the same manual linear filtering
+// as the reference (transfer::Lut::sample) and opacity correction
+// α' = 1 − (1 − α)^(Δ/Δ₀) (transfer::opacity::correct).
+
+#import focal::types::Region
+#import focal::sampling::lut_texel
+
+fn classify(r: Region, t: f32, atlas_width: u32) -> vec4<f32> {
+    let n = f32(r.lut_width);
+    let x = clamp((r.lut_a * t + r.lut_b) * n - 0.5, 0.0, n - 1.0);
+    let i = min(u32(x), r.lut_width - 2u);
+    let f = x - f32(i);
+    return mix(lut_texel(r.lut_offset + i, atlas_width), lut_texel(r.lut_offset + i + 1u, atlas_width), f);
+}
+
+fn classify_label(r: Region, code: u32, atlas_width: u32) -> vec4<f32> {
+    if code >= r.lut_width {
+        return vec4(0.0);
+    }
+    return lut_texel(r.lut_offset + code, atlas_width);
+}
+
+fn correct_opacity(alpha: f32, ratio: f32) -> f32 {
+    if alpha >= 1.0 {
+        return 1.0;
+    }
+    return 1.0 - pow(1.0 - max(alpha, 0.0), ratio);
+}

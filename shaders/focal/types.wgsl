@@ -1,0 +1,64 @@
+#define_import_path focal::types
+
+// Mirrors src/render/gpu_types.rs (field order and types must match).
+
+struct Region {
+    world_to_voxel: mat4x4<f32>,
+    normal_matrix: mat4x4<f32>,
+    to_native: mat4x4<f32>,
+    dims: vec4<f32>,
+    shading: vec4<f32>,
+    bricks: vec4<u32>,
+    plane_offset: u32,
+    plane_count: u32,
+    slot: u32,
+    mode: u32,
+    flags: u32,
+    lut_offset: u32,
+    lut_width: u32,
+    occupancy_offset: u32,
+    lut_a: f32,
+    lut_b: f32,
+    native_step: f32,
+    reference_length: f32,
+    iso: f32,
+    gradient_max: f32,
+    pad_a: f32,
+    pad_b: f32,
+}
+
+struct Settings {
+    light: vec4<f32>,
+    flags: u32,
+    frame: u32,
+    pad: u32,
+}
+
+struct SceneInfo {
+    region_count: u32,
+    lut_atlas_width: u32,
+    pad_a: u32,
+    pad_b: u32,
+}
+
+const MODE_DVR: u32 = 0u;
+const MODE_MIP: u32 = 1u;
+const MODE_MIN_IP: u32 = 2u;
+const MODE_X_RAY: u32 = 3u;
+const MODE_GRADIENT_DVR: u32 = 4u;
+const MODE_ISO: u32 = 5u;
+
+const REGION_LABELS: u32 = 1u;
+const REGION_SHADING: u32 = 2u;
+const REGION_OCCUPANCY: u32 = 4u;
+
+const VIEW_JITTER: u32 = 1u;
+const VIEW_SKIP_EMPTY: u32 = 2u;
+const VIEW_EARLY_TERMINATION: u32 = 4u;
+
+// Accumulated opacity at which a ray stops (reference: trace::EARLY_TERMINATION).
+const EARLY_TERMINATION: f32 = 0.99;
+// Bisection steps refining an iso-surface crossing (reference: trace::ISO_REFINEMENT).
+const ISO_REFINEMENT: u32 = 8u;
+// Most regions one ray can cross.
+const MAX_RAY_REGIONS: u32 = 12u;

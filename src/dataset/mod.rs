@@ -1,0 +1,96 @@
+//! Datasets: volumes shown in the scene, each an entity.
+//!
+//! A [`Dataset`] holds its volume (shared, immutable), its appearance and a display
+//! name; its `Transform` places it in the world (identity = the volume's own RAS
+//! millimetres). Every frame [`collect_regions`] turns the datasets into the
+//! [`SceneRegions`] both renderers draw: one region per visible dataset, its box mapped
+//! through the inverse of the dataset's transform. Later techniques (windows, exploded
+//! parts) add or replace regions after it, in [`RegionSystems::Modify`].
+
+pub mod gpu_fit;
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+
+use crate::region::{Appearance, Light, Region, RenderScene};
+use crate::volume::Volume;
+
+/// A volume in the scene.
+#[derive(Component, Clone)]
+pub struct Dataset {
+    pub volume: Arc<Volume>,
+    pub appearance: Appearance,
+    /// Whether this dataset is drawn.
+    pub visible: bool,
+}
+
+impl Dataset {
+    pub fn new(volume: Arc<Volume>, appearance: Appearance) -> Self {
+        Self { volume, appearance, visible: true }
+    }
+}
+
+/// The volume the GPU draws for a dataset, when it had to be reduced to fit the device
+/// (set by [`gpu_fit`]); the warning says so.
+#[derive(Component, Clone)]
+pub struct GpuVolume {
+    pub volume: Arc<Volume>,
+    pub warning: Option<String>,
+}
+
+/// The scene the renderers draw, rebuilt every frame from the datasets.
+#[derive(Resource, Clone, Default)]
+pub struct SceneRegions {
+    pub scene: RenderScene,
+}
+
+/// Lighting of the scene.
+#[derive(Resource, Clone, Copy, Default, PartialEq)]
+pub struct SceneLight(pub Light);
+
+/// Ordering of the systems that build [`SceneRegions`].
+#[derive(SystemSet, Debug, Clone, PartialEq, Eq, Hash)]
+pub enum RegionSystems {
+    /// Datasets become regions.
+    Collect,
+    /// Techniques add or change regions.
+    Modify,
+}
+
+/// Collects one region per visible dataset.
+pub fn collect_regions(
+    datasets: Query<(&Dataset, Option<&GpuVolume>, &GlobalTransform)>,
+    light: Res<SceneLight>,
+    mut out: ResMut<SceneRegions>,
+) {
+    let mut scene = RenderScene { light: light.0, ..Default::default() };
+    for (d, gpu, transform) in &datasets {
+        if !d.visible {
+            continue;
+        }
+        let volume = gpu.map(|g| g.volume.clone()).unwrap_or_else(|| d.volume.clone());
+        let index = scene.volumes.len();
+        let mut region = Region::volume_box(&volume.grid, index, index);
+        // A dataset moved by `transform`: world → dataset space → voxel.
+        let to_local = transform.affine().inverse();
+        region.world_to_voxel = volume.grid.world_to_index() * to_local;
+        region.planes = crate::region::box_planes(&region.world_to_voxel, Vec3::splat(-0.5), volume.dims().as_vec3() - 0.5);
+        scene.volumes.push(volume);
+        scene.appearances.push(d.appearance.clone());
+        scene.regions.push(region);
+    }
+    out.scene = scene;
+}
+
+/// Datasets and the scene regions, without any GPU.
+pub struct DatasetPlugin;
+
+impl Plugin for DatasetPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<SceneRegions>()
+            .init_resource::<SceneLight>()
+            .configure_sets(PostUpdate, (RegionSystems::Collect, RegionSystems::Modify).chain().after(TransformSystems::Propagate))
+            .add_systems(PostUpdate, collect_regions.in_set(RegionSystems::Collect));
+    }
+}

@@ -1,0 +1,45 @@
+//! A renderable scene description: volumes, the regions showing them, their
+//! appearances and the lighting. Both renderers take it (the CPU reference directly, the
+//! GPU renderer after packing); the techniques produce it.
+
+use std::sync::Arc;
+
+use super::{Appearance, Light, Region};
+use crate::volume::Volume;
+
+/// Volumes, regions and appearances to render.
+#[derive(Clone, Debug)]
+pub struct RenderScene {
+    pub volumes: Vec<Arc<Volume>>,
+    pub regions: Vec<Region>,
+    pub appearances: Vec<Appearance>,
+    /// Background colour (display sRGB values).
+    pub background: [f32; 3],
+    pub light: Light,
+    /// Jitter ray starts per pixel (against wood-grain artefacts).
+    pub jitter: bool,
+    /// Skip bricks the transfer function makes invisible (exact; off only to measure).
+    pub skip_empty: bool,
+}
+
+impl Default for RenderScene {
+    fn default() -> Self {
+        RenderScene {
+            volumes: Vec::new(),
+            regions: Vec::new(),
+            appearances: Vec::new(),
+            background: [0.0; 3],
+            light: Light::Headlight,
+            jitter: false,
+            skip_empty: true,
+        }
+    }
+}
+
+impl RenderScene {
+    /// One volume shown in its own box with one appearance.
+    pub fn single(volume: Arc<Volume>, appearance: Appearance) -> Self {
+        let region = Region::volume_box(&volume.grid, 0, 0);
+        RenderScene { volumes: vec![volume], regions: vec![region], appearances: vec![appearance], ..Default::default() }
+    }
+}

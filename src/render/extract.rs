@@ -1,0 +1,84 @@
+//! Main world → render world: the scene regions and the per-view settings.
+
+use bevy::prelude::*;
+use bevy::render::Extract;
+use bevy::render::extract_component::ExtractComponent;
+use bevy::render::render_resource::TextureUsages;
+use bevy::render::sync_component::SyncComponent;
+
+use super::gpu_types::{GpuSettings, view_flags};
+use crate::dataset::SceneRegions;
+use crate::region::{Light, RenderScene};
+
+/// Marks a camera that shows the volumes, with its rendering switches.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct VolumeView {
+    /// Jitter ray starts per pixel (against wood-grain artefacts).
+    pub jitter: bool,
+    /// Skip bricks the transfer functions make invisible.
+    pub skip_empty: bool,
+    /// Stop rays once they are opaque.
+    pub early_termination: bool,
+    /// Seed of the jitter pattern.
+    pub frame: u32,
+    /// Light of the view (copied from the scene each frame).
+    pub light: Light,
+}
+
+impl Default for VolumeView {
+    fn default() -> Self {
+        Self { jitter: true, skip_empty: true, early_termination: true, frame: 0, light: Light::Headlight }
+    }
+}
+
+impl SyncComponent for VolumeView {
+    type Target = GpuSettings;
+}
+
+impl ExtractComponent for VolumeView {
+    type QueryData = &'static VolumeView;
+    type QueryFilter = With<Camera3d>;
+    type Out = GpuSettings;
+
+    fn extract_component(v: &VolumeView) -> Option<GpuSettings> {
+        let mut flags = 0;
+        if v.jitter {
+            flags |= view_flags::JITTER;
+        }
+        if v.skip_empty {
+            flags |= view_flags::SKIP_EMPTY;
+        }
+        if v.early_termination {
+            flags |= view_flags::EARLY_TERMINATION;
+        }
+        let light = match v.light {
+            Light::Headlight => Vec4::ZERO,
+            Light::Direction(d) => d.normalize_or_zero().extend(1.0),
+        };
+        Some(GpuSettings { light, flags, frame: v.frame, pad: 0 })
+    }
+}
+
+/// The main depth texture must be bindable so the pass can read it.
+pub fn request_depth_binding(mut cams: Query<(&mut Camera3d, &mut VolumeView)>, light: Res<crate::dataset::SceneLight>) {
+    for (mut cam, mut view) in &mut cams {
+        let usage = TextureUsages::RENDER_ATTACHMENT | TextureUsages::TEXTURE_BINDING;
+        if cam.depth_texture_usages.0 != usage.bits() {
+            cam.depth_texture_usages = usage.into();
+        }
+        if view.light != light.0 {
+            view.light = light.0;
+        }
+    }
+}
+
+/// The scene as the render world sees it.
+#[derive(Resource, Clone, Default)]
+pub struct ExtractedScene {
+    pub scene: RenderScene,
+}
+
+/// Copies the scene regions into the render world (shared volumes, small vectors).
+pub fn extract_scene(mut commands: Commands, scene: Extract<Res<SceneRegions>>) {
+    commands.insert_resource(ExtractedScene { scene: scene.scene.clone() });
+}

@@ -1,0 +1,85 @@
+//! The GPU layout of the per-pixel function's inputs (std430 / uniform rules via
+//! `encase`). Field order and types match `shaders/focal/types.wgsl` exactly.
+
+use bevy::prelude::Component;
+use bevy::render::render_resource::ShaderType;
+use glam::{Mat4, UVec4, Vec4};
+
+/// Mode numbers shared with the shader.
+pub mod mode {
+    pub const DVR: u32 = 0;
+    pub const MIP: u32 = 1;
+    pub const MIN_IP: u32 = 2;
+    pub const X_RAY: u32 = 3;
+    pub const GRADIENT_DVR: u32 = 4;
+    pub const ISO: u32 = 5;
+}
+
+/// Region flags.
+pub mod region_flags {
+    /// Codes are label ids: nearest sampling and a per-id table.
+    pub const LABELS: u32 = 1;
+    /// Blinn-Phong shading on.
+    pub const SHADING: u32 = 2;
+    /// The occupancy bits of this region may be used to skip bricks.
+    pub const OCCUPANCY: u32 = 4;
+}
+
+/// View settings flags.
+pub mod view_flags {
+    pub const JITTER: u32 = 1;
+    pub const SKIP_EMPTY: u32 = 2;
+    pub const EARLY_TERMINATION: u32 = 4;
+}
+
+/// One region, with everything the shader needs about its volume and appearance.
+#[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
+pub struct GpuRegion {
+    pub world_to_voxel: Mat4,
+    /// Upper 3×3: world→voxel linear part transposed (voxel gradient → world normal).
+    pub normal_matrix: Mat4,
+    /// Upper 3×3: world direction → the volume's own millimetres (for step lengths).
+    pub to_native: Mat4,
+    /// Voxel dimensions (xyz) and the largest code of the storage type (w).
+    pub dims: Vec4,
+    /// ambient, diffuse, specular, shininess.
+    pub shading: Vec4,
+    /// Brick grid dimensions (xyz) and brick size (w).
+    pub bricks: UVec4,
+    pub plane_offset: u32,
+    pub plane_count: u32,
+    pub slot: u32,
+    pub mode: u32,
+    pub flags: u32,
+    pub lut_offset: u32,
+    pub lut_width: u32,
+    pub occupancy_offset: u32,
+    pub lut_a: f32,
+    pub lut_b: f32,
+    pub native_step: f32,
+    pub reference_length: f32,
+    pub iso: f32,
+    pub gradient_max: f32,
+    pub pad_a: f32,
+    pub pad_b: f32,
+}
+
+/// Per-view settings.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, ShaderType)]
+pub struct GpuSettings {
+    /// Light direction towards the light (xyz), w = 1 for a fixed light, 0 for headlight.
+    pub light: Vec4,
+    pub flags: u32,
+    pub frame: u32,
+    pub pad: u32,
+}
+
+/// Per-scene facts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
+pub struct GpuSceneInfo {
+    pub region_count: u32,
+    /// Width of the LUT atlas in texels.
+    pub lut_atlas_width: u32,
+    pub pad_a: u32,
+    pub pad_b: u32,
+}

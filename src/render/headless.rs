@@ -1,0 +1,171 @@
+//! Rendering without a window: a Bevy app with Focal's plugins drawing into an image
+//! target, read back after each capture. Used by `focal render`, the GPU image tests and
+//! `focal bench`.
+//!
+//! Pipelines compile synchronously, and a capture waits a few frames after the scene
+//! changes so the volume upload and the pipeline are in place.
+
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use bevy::asset::RenderAssetUsages;
+use bevy::camera::RenderTarget;
+use bevy::camera::ScalingMode;
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::prelude::*;
+use bevy::render::RenderPlugin;
+use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
+use bevy::render::render_resource::{Extent3d, PollType, TextureDimension, TextureFormat, TextureUsages};
+use bevy::render::renderer::{RenderAdapterInfo, RenderDevice};
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy::window::ExitCondition;
+use bevy::winit::WinitPlugin;
+
+use super::VolumeView;
+use crate::region::{Camera as FocalCamera, Projection as FocalProjection};
+
+/// Frames drawn after a change before the image is captured.
+const SETTLE_FRAMES: u32 = 3;
+
+/// The Bevy camera components that show a Focal camera.
+pub fn camera_bundle(cam: &FocalCamera) -> (Transform, Projection) {
+    let projection = match cam.projection {
+        FocalProjection::Perspective { fov_y } => Projection::Perspective(PerspectiveProjection { fov: fov_y, near: 0.1, ..default() }),
+        FocalProjection::Orthographic { height } => Projection::Orthographic(OrthographicProjection {
+            near: 0.0,
+            far: 1.0e6,
+            scaling_mode: ScalingMode::FixedVertical { viewport_height: height },
+            ..OrthographicProjection::default_3d()
+        }),
+    };
+    (Transform { translation: cam.position, rotation: cam.rotation, scale: Vec3::ONE }, projection)
+}
+
+/// An app that renders into an image.
+pub struct Offscreen {
+    app: App,
+    target: Handle<Image>,
+    camera: Entity,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Offscreen {
+    /// Builds the app and its GPU device; `plugins` adds Focal's (or a test's) plugins.
+    pub fn new(width: u32, height: u32, plugins: impl FnOnce(&mut App)) -> Result<Offscreen, String> {
+        if width == 0 || height == 0 || width > 16384 || height > 16384 {
+            return Err(format!("image size {width}×{height} is not 1..16384 on each side"));
+        }
+        let mut app = App::new();
+        app.add_plugins(
+            DefaultPlugins
+                .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
+                .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() })
+                .disable::<WinitPlugin>()
+                // One update = one rendered frame, so a GPU wait covers the frame just updated.
+                .disable::<PipelinedRenderingPlugin>(),
+        );
+        plugins(&mut app);
+        app.finish();
+        app.cleanup();
+        if app.world().get_resource::<RenderDevice>().is_none() {
+            return Err("no GPU device (install mesa-vulkan-drivers for software Vulkan, and set WGPU_BACKEND=vulkan)".into());
+        }
+        let mut target = Image::new_uninit(
+            Extent3d { width, height, depth_or_array_layers: 1 },
+            TextureDimension::D2,
+            TextureFormat::Rgba8UnormSrgb,
+            RenderAssetUsages::RENDER_WORLD,
+        );
+        target.texture_descriptor.usage |= TextureUsages::RENDER_ATTACHMENT | TextureUsages::COPY_SRC;
+        let world = app.world_mut();
+        let target = world.resource_mut::<Assets<Image>>().add(target);
+        let camera = world
+            .spawn((
+                Camera3d::default(),
+                RenderTarget::Image(target.clone().into()),
+                Msaa::Off,
+                Tonemapping::None,
+                Camera { clear_color: Color::BLACK.into(), ..default() },
+                Transform::from_xyz(0.0, -500.0, 0.0).looking_at(Vec3::ZERO, Vec3::Z),
+                VolumeView::default(),
+            ))
+            .id();
+        Ok(Offscreen { app, target, camera, width, height })
+    }
+
+    /// The adapter the app renders with (`llvmpipe` on software Vulkan).
+    pub fn adapter_name(&self) -> String {
+        self.app.world().get_resource::<RenderAdapterInfo>().map(|i| i.name.clone()).unwrap_or_default()
+    }
+
+    pub fn world_mut(&mut self) -> &mut World {
+        self.app.world_mut()
+    }
+
+    pub fn camera(&self) -> Entity {
+        self.camera
+    }
+
+    /// Points the camera.
+    pub fn set_camera(&mut self, cam: &FocalCamera) {
+        let (transform, projection) = camera_bundle(cam);
+        self.app.world_mut().entity_mut(self.camera).insert((transform, projection));
+    }
+
+    /// Sets the background (display sRGB).
+    pub fn set_background(&mut self, rgb: [f32; 3]) {
+        let color = Color::srgb(rgb[0], rgb[1], rgb[2]);
+        if let Some(mut cam) = self.app.world_mut().get_mut::<Camera>(self.camera) {
+            cam.clear_color = color.into();
+        }
+    }
+
+    /// Sets the ray-caster switches of the camera.
+    pub fn set_view(&mut self, view: VolumeView) {
+        self.app.world_mut().entity_mut(self.camera).insert(view);
+    }
+
+    /// Runs one frame and waits for the GPU.
+    pub fn update(&mut self) {
+        self.app.update();
+        if let Some(device) = self.app.world().get_resource::<RenderDevice>() {
+            let _ = device.wgpu_device().poll(PollType::Wait { submission_index: None, timeout: None });
+        }
+    }
+
+    /// Renders and reads back the image (sRGB-encoded RGBA8).
+    pub fn capture(&mut self) -> Result<image::RgbaImage, String> {
+        for _ in 0..SETTLE_FRAMES {
+            self.update();
+        }
+        let captured: Arc<Mutex<Option<Image>>> = default();
+        let sink = captured.clone();
+        self.app.world_mut().spawn(Screenshot::image(self.target.clone())).observe(move |ev: On<ScreenshotCaptured>| {
+            if let Ok(mut slot) = sink.lock() {
+                *slot = Some(ev.image.clone());
+            }
+        });
+        for _ in 0..10 {
+            self.update();
+            let image = captured.lock().ok().and_then(|mut s| s.take());
+            if let Some(image) = image {
+                let dynamic = image.try_into_dynamic().map_err(|e| format!("captured image: {e}"))?;
+                return Ok(dynamic.to_rgba8());
+            }
+        }
+        Err("the GPU produced no image".into())
+    }
+
+    /// Average wall-clock time of `frames` frames (after the scene settled).
+    pub fn time_frames(&mut self, frames: u32) -> Duration {
+        for _ in 0..SETTLE_FRAMES {
+            self.update();
+        }
+        let t = Instant::now();
+        for _ in 0..frames.max(1) {
+            self.update();
+        }
+        t.elapsed() / frames.max(1)
+    }
+}

@@ -1,0 +1,73 @@
+//! The GPU ray caster: a render pass in Bevy 0.19's `Core3d` schedule.
+//!
+//! Main world: [`crate::dataset`] builds the [`SceneRegions`] every frame; cameras that
+//! should show volumes carry a [`VolumeView`]. Render world:
+//! - [`extract`] copies the scene (shared `Arc`s, small vectors) and each view's settings;
+//! - [`upload`] packs the scene ([`pack`], reusing the CPU reference's preparation) into
+//!   storage buffers and a lookup-table atlas, and uploads the volumes as 3D textures
+//!   (`R8Unorm`; `R16Unorm`, or `R16Float` where 16-bit normalised formats are missing)
+//!   with their brick min-max grids (`Rg16Uint`), only when something changed;
+//! - [`pass`] draws one full-screen triangle per view running `shaders/raycast.wgsl`,
+//!   after the opaque and transparent main passes so it reads their depth, blending the
+//!   premultiplied result over the meshes.
+//!
+//! The renderer packs; it does not decide: what is drawn where is the techniques'
+//! business (datasets, windows, exploded parts), expressed as regions.
+
+pub mod extract;
+pub mod gpu_types;
+pub mod headless;
+pub mod pack;
+pub mod pass;
+pub mod pipeline;
+pub mod shaders;
+pub mod upload;
+
+use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
+use bevy::prelude::*;
+use bevy::render::extract_component::{ExtractComponentPlugin, UniformComponentPlugin};
+use bevy::render::renderer::RenderDevice;
+use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
+
+pub use extract::VolumeView;
+pub use gpu_types::GpuSettings;
+
+use crate::dataset::SceneRegions;
+use crate::dataset::gpu_fit::{GpuLimits, fit_datasets};
+
+/// The volume ray caster.
+pub struct VolumeRenderPlugin;
+
+impl Plugin for VolumeRenderPlugin {
+    fn build(&self, app: &mut App) {
+        shaders::register(app);
+
+        app.init_resource::<GpuLimits>()
+            .add_plugins((ExtractComponentPlugin::<VolumeView>::default(), UniformComponentPlugin::<GpuSettings>::default()))
+            .add_systems(PostUpdate, (extract::request_depth_binding, fit_datasets.before(crate::dataset::RegionSystems::Collect)));
+
+        let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
+            return;
+        };
+        render_app
+            .init_resource::<upload::GpuScene>()
+            .init_resource::<bevy::render::render_resource::SpecializedRenderPipelines<pipeline::RaycastPipeline>>()
+            .add_systems(bevy::render::ExtractSchedule, extract::extract_scene)
+            .add_systems(RenderStartup, pipeline::init_pipeline)
+            .add_systems(
+                Render,
+                (upload::upload_scene.in_set(RenderSystems::PrepareResources), pipeline::prepare_pipelines.in_set(RenderSystems::Prepare)),
+            )
+            .add_systems(Core3d, pass::raycast_pass.after(Core3dSystems::MainPass).before(Core3dSystems::EarlyPostProcess));
+    }
+
+    fn finish(&self, app: &mut App) {
+        // The device exists now: record its limits for fitting datasets.
+        if let Some(device) = app.world().get_resource::<RenderDevice>() {
+            let limits = device.limits();
+            let max_bytes = GpuLimits::default().max_bytes.min(limits.max_buffer_size);
+            app.insert_resource(GpuLimits { max_dimension: limits.max_texture_dimension_3d, max_bytes });
+        }
+        let _ = app.world().get_resource::<SceneRegions>();
+    }
+}

@@ -1,0 +1,77 @@
+//! The ray-cast pass: a system in the `Core3d` schedule, one full-screen triangle per view.
+
+use bevy::prelude::*;
+use bevy::render::extract_component::{ComponentUniforms, DynamicUniformIndex};
+use bevy::render::render_resource::*;
+use bevy::render::renderer::{RenderContext, ViewQuery};
+use bevy::render::view::{ViewDepthTexture, ViewTarget, ViewUniformOffset, ViewUniforms};
+
+use super::gpu_types::GpuSettings;
+use super::pipeline::{RaycastPipeline, RaycastPipelineId};
+use super::upload::GpuScene;
+
+#[allow(clippy::too_many_arguments)]
+pub fn raycast_pass(
+    view: ViewQuery<(&ViewTarget, &ViewDepthTexture, &ViewUniformOffset, &DynamicUniformIndex<GpuSettings>, &RaycastPipelineId)>,
+    pipeline: Res<RaycastPipeline>,
+    cache: Res<PipelineCache>,
+    view_uniforms: Res<ViewUniforms>,
+    settings: Res<ComponentUniforms<GpuSettings>>,
+    scene: Res<GpuScene>,
+    mut ctx: RenderContext,
+) {
+    let (target, depth, view_offset, settings_index, pipeline_id) = view.into_inner();
+    if scene.region_count == 0 || !scene.ready() {
+        return;
+    }
+    let (Some(render_pipeline), Some(view_binding), Some(settings_binding)) =
+        (cache.get_render_pipeline(pipeline_id.0), view_uniforms.uniforms.binding(), settings.uniforms().binding())
+    else {
+        return;
+    };
+    let (Some(info), Some(regions), Some(planes), Some(occupancy), Some((_, lut))) =
+        (&scene.info, &scene.regions, &scene.planes, &scene.occupancy, &scene.lut)
+    else {
+        return;
+    };
+    let s = &scene.slots;
+    let bind_group = ctx.render_device().create_bind_group(
+        "focal_raycast_bind_group",
+        &cache.get_bind_group_layout(&pipeline.layout),
+        &BindGroupEntries::sequential((
+            view_binding,
+            settings_binding,
+            info.as_entire_binding(),
+            regions.as_entire_binding(),
+            planes.as_entire_binding(),
+            occupancy.as_entire_binding(),
+            lut,
+            &s[0].volume,
+            &s[1].volume,
+            &s[2].volume,
+            &s[3].volume,
+            &s[0].minmax,
+            &s[1].minmax,
+            &s[2].minmax,
+            &s[3].minmax,
+            &pipeline.sampler,
+            depth.view(),
+        )),
+    );
+    let mut pass = ctx.command_encoder().begin_render_pass(&RenderPassDescriptor {
+        label: Some("focal_raycast_pass"),
+        color_attachments: &[Some(RenderPassColorAttachment {
+            view: target.main_texture_view(),
+            depth_slice: None,
+            resolve_target: None,
+            ops: Operations { load: LoadOp::Load, store: StoreOp::Store },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(render_pipeline);
+    pass.set_bind_group(0, &bind_group, &[view_offset.offset, settings_index.index()]);
+    pass.draw(0..3, 0..1);
+}

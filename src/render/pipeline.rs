@@ -1,0 +1,107 @@
+//! The ray-cast pipeline: bind group layout, specialisation per target format.
+
+use bevy::core_pipeline::FullscreenShader;
+use bevy::prelude::*;
+use bevy::render::render_resource::binding_types::{
+    sampler, storage_buffer_read_only_sized, texture_2d, texture_3d, texture_depth_2d, uniform_buffer,
+};
+use bevy::render::render_resource::*;
+use bevy::render::renderer::RenderDevice;
+use bevy::render::view::{ExtractedView, ViewTarget, ViewUniform};
+use bevy::shader::Shader;
+
+use super::gpu_types::{GpuSceneInfo, GpuSettings};
+
+/// Pipeline state shared by every view.
+#[derive(Resource)]
+pub struct RaycastPipeline {
+    pub layout: BindGroupLayoutDescriptor,
+    pub sampler: Sampler,
+    fullscreen: FullscreenShader,
+    shader: Handle<Shader>,
+}
+
+pub fn init_pipeline(mut commands: Commands, device: Res<RenderDevice>, fullscreen: Res<FullscreenShader>) {
+    let float = |filterable| TextureSampleType::Float { filterable };
+    let layout = BindGroupLayoutDescriptor::new(
+        "focal_raycast_layout",
+        &BindGroupLayoutEntries::sequential(
+            ShaderStages::FRAGMENT,
+            (
+                uniform_buffer::<ViewUniform>(true),
+                uniform_buffer::<GpuSettings>(true),
+                uniform_buffer::<GpuSceneInfo>(false),
+                storage_buffer_read_only_sized(false, None),
+                storage_buffer_read_only_sized(false, None),
+                storage_buffer_read_only_sized(false, None),
+                texture_2d(float(false)),
+                texture_3d(float(true)),
+                texture_3d(float(true)),
+                texture_3d(float(true)),
+                texture_3d(float(true)),
+                texture_3d(TextureSampleType::Uint),
+                texture_3d(TextureSampleType::Uint),
+                texture_3d(TextureSampleType::Uint),
+                texture_3d(TextureSampleType::Uint),
+                sampler(SamplerBindingType::Filtering),
+                texture_depth_2d(),
+            ),
+        ),
+    );
+    let sampler = device.create_sampler(&SamplerDescriptor {
+        label: Some("focal volume sampler"),
+        mag_filter: FilterMode::Linear,
+        min_filter: FilterMode::Linear,
+        address_mode_u: AddressMode::ClampToEdge,
+        address_mode_v: AddressMode::ClampToEdge,
+        address_mode_w: AddressMode::ClampToEdge,
+        ..default()
+    });
+    commands.insert_resource(RaycastPipeline { layout, sampler, fullscreen: fullscreen.clone(), shader: super::shaders::RAYCAST });
+}
+
+/// Pipeline variant: the view's colour format.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct RaycastKey {
+    format: TextureFormat,
+}
+
+impl SpecializedRenderPipeline for RaycastPipeline {
+    type Key = RaycastKey;
+
+    fn specialize(&self, key: RaycastKey) -> RenderPipelineDescriptor {
+        RenderPipelineDescriptor {
+            label: Some("focal_raycast_pipeline".into()),
+            layout: vec![self.layout.clone()],
+            vertex: self.fullscreen.to_vertex_state(),
+            fragment: Some(FragmentState {
+                shader: self.shader.clone(),
+                targets: vec![Some(ColorTargetState {
+                    format: key.format,
+                    // Premultiplied "over" onto the meshes already drawn.
+                    blend: Some(BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+                    write_mask: ColorWrites::ALL,
+                })],
+                ..default()
+            }),
+            ..default()
+        }
+    }
+}
+
+/// The pipeline of a view.
+#[derive(Component)]
+pub struct RaycastPipelineId(pub CachedRenderPipelineId);
+
+pub fn prepare_pipelines(
+    mut commands: Commands,
+    cache: Res<PipelineCache>,
+    mut pipelines: ResMut<SpecializedRenderPipelines<RaycastPipeline>>,
+    pipeline: Res<RaycastPipeline>,
+    views: Query<(Entity, &ViewTarget), (With<ExtractedView>, With<GpuSettings>)>,
+) {
+    for (entity, target) in &views {
+        let id = pipelines.specialize(&cache, &pipeline, RaycastKey { format: target.main_texture_format() });
+        commands.entity(entity).insert(RaycastPipelineId(id));
+    }
+}

@@ -1,0 +1,49 @@
+//! The WGSL of the ray caster, embedded in the binary under fixed handles. The shared
+//! modules (`#define_import_path focal::…`) are registered by path so imports resolve;
+//! the entry shader is referenced by [`RAYCAST`].
+
+use bevy::asset::{Handle, uuid_handle};
+use bevy::prelude::*;
+use bevy::shader::Shader;
+
+/// The ray-cast fragment shader.
+pub const RAYCAST: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a11");
+
+/// (fixed handle, file name, source) of every shader.
+const SHADERS: [(Handle<Shader>, &str, &str); 9] = [
+    (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a01"), "shaders/focal/types.wgsl", include_str!("../../shaders/focal/types.wgsl")),
+    (
+        uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a02"),
+        "shaders/focal/bindings.wgsl",
+        include_str!("../../shaders/focal/bindings.wgsl"),
+    ),
+    (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a03"), "shaders/focal/camera.wgsl", include_str!("../../shaders/focal/camera.wgsl")),
+    (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a04"), "shaders/focal/regions.wgsl", include_str!("../../shaders/focal/regions.wgsl")),
+    (
+        uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a05"),
+        "shaders/focal/sampling.wgsl",
+        include_str!("../../shaders/focal/sampling.wgsl"),
+    ),
+    (
+        uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a06"),
+        "shaders/focal/transfer.wgsl",
+        include_str!("../../shaders/focal/transfer.wgsl"),
+    ),
+    (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a07"), "shaders/focal/shading.wgsl", include_str!("../../shaders/focal/shading.wgsl")),
+    (
+        uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a08"),
+        "shaders/focal/compositing.wgsl",
+        include_str!("../../shaders/focal/compositing.wgsl"),
+    ),
+    (RAYCAST, "shaders/raycast.wgsl", include_str!("../../shaders/raycast.wgsl")),
+];
+
+/// Inserts every shader into `Assets<Shader>`.
+pub fn register(app: &mut App) {
+    let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
+    for (handle, path, source) in SHADERS {
+        if let Err(e) = shaders.insert(handle.id(), Shader::from_wgsl(source, path)) {
+            error!("cannot register {path}: {e}");
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! Scene files (RON): datasets, appearances, camera and the frames to capture.

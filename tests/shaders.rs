@@ -1,0 +1,61 @@
+//! The WGSL composes and validates without a GPU (naga_oil + naga, as Bevy does), with
+//! stand-ins for the two Bevy modules it imports. Errors name the function involved.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderLanguage, ShaderType};
+
+const BEVY_VIEW: &str = "#define_import_path bevy_render::view
+struct View { world_from_clip: mat4x4<f32>, world_position: vec3<f32> }";
+const BEVY_FULLSCREEN: &str = "#define_import_path bevy_core_pipeline::fullscreen_vertex_shader
+struct FullscreenVertexOutput { @builtin(position) position: vec4<f32>, @location(0) uv: vec2<f32> }";
+
+const MODULES: [&str; 8] = ["types", "bindings", "camera", "regions", "sampling", "transfer", "shading", "compositing"];
+
+fn read(rel: &str) -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
+fn add(composer: &mut Composer, source: &str, path: &str) {
+    let result = composer.add_composable_module(ComposableModuleDescriptor {
+        source,
+        file_path: path,
+        language: ShaderLanguage::Wgsl,
+        ..Default::default()
+    });
+    if let Err(e) = result {
+        panic!("{path}: {}", e.emit_to_string(composer));
+    }
+}
+
+#[test]
+fn raycast_shader_composes_and_validates() {
+    let mut composer = Composer::default();
+    add(&mut composer, BEVY_VIEW, "bevy_view.wgsl");
+    add(&mut composer, BEVY_FULLSCREEN, "fullscreen.wgsl");
+    // Modules in dependency order.
+    let sources: Vec<(String, String)> =
+        MODULES.iter().map(|m| (format!("shaders/focal/{m}.wgsl"), read(&format!("shaders/focal/{m}.wgsl")))).collect();
+    for (path, source) in &sources {
+        add(&mut composer, source, path);
+    }
+    let main = read("shaders/raycast.wgsl");
+    let module = composer
+        .make_naga_module(NagaModuleDescriptor {
+            source: &main,
+            file_path: "shaders/raycast.wgsl",
+            shader_type: ShaderType::Wgsl,
+            shader_defs: HashMap::new(),
+            additional_imports: &[],
+        })
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
+    let mut validator = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
+    if let Err(e) = validator.validate(&module) {
+        let functions: Vec<String> =
+            module.functions.iter().map(|(h, f)| format!("{h:?} = {}", f.name.clone().unwrap_or_default())).collect();
+        let types: Vec<String> =
+            module.types.iter().map(|(h, t)| format!("{h:?} = {:?}", t.name.clone().unwrap_or_else(|| format!("{:?}", t.inner)))).collect();
+        panic!("validation failed: {e:?}\nfunctions: {functions:#?}\ntypes: {types:#?}");
+    }
+}
