@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderLanguage, ShaderType};
+use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage, ShaderType};
 
 const BEVY_VIEW: &str = "#define_import_path bevy_render::view
 struct View { world_from_clip: mat4x4<f32>, world_position: vec3<f32> }";
@@ -29,8 +29,30 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
     }
 }
 
+/// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
+const DEFS: [&str; 7] = ["HAS_DVR", "HAS_GRADIENT_MODULATION", "HAS_LABELS", "HAS_PROJECTION", "HAS_ISO", "HAS_SHADING", "MULTI_REGION"];
+
 #[test]
-fn raycast_shader_composes_and_validates() {
+fn every_shader_variant_composes_and_validates() {
+    for bits in 0u32..(1 << DEFS.len()) {
+        let defs: HashMap<String, ShaderDefValue> = DEFS
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| bits & (1 << i) != 0)
+            .map(|(_, d)| (d.to_string(), ShaderDefValue::Bool(true)))
+            .collect();
+        compose_and_validate(defs);
+    }
+}
+
+#[test]
+fn def_names_match_the_renderer() {
+    let names: Vec<&str> = focal::render::gpu_types::features::NAMES.iter().map(|(_, n)| *n).collect();
+    assert_eq!(names, DEFS);
+}
+
+fn compose_and_validate(shader_defs: HashMap<String, ShaderDefValue>) {
+    let label = format!("{:?}", shader_defs.keys().collect::<Vec<_>>());
     let mut composer = Composer::default();
     add(&mut composer, BEVY_VIEW, "bevy_view.wgsl");
     add(&mut composer, BEVY_FULLSCREEN, "fullscreen.wgsl");
@@ -56,6 +78,6 @@ fn raycast_shader_composes_and_validates() {
             module.functions.iter().map(|(h, f)| format!("{h:?} = {}", f.name.clone().unwrap_or_default())).collect();
         let types: Vec<String> =
             module.types.iter().map(|(h, t)| format!("{h:?} = {:?}", t.name.clone().unwrap_or_else(|| format!("{:?}", t.inner)))).collect();
-        panic!("validation failed: {e:?}\nfunctions: {functions:#?}\ntypes: {types:#?}");
+        panic!("{label}: validation failed: {e:?}\nfunctions: {functions:#?}\ntypes: {types:#?}");
     }
 }

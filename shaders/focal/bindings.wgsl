@@ -10,13 +10,7 @@
 @group(0) @binding(4) var<storage, read> planes: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> occupancy: array<u32>;
 @group(0) @binding(6) var lut_atlas: texture_2d<f32>;
-@group(0) @binding(7) var volume_a: texture_3d<f32>;
-@group(0) @binding(8) var volume_b: texture_3d<f32>;
-@group(0) @binding(9) var volume_c: texture_3d<f32>;
-@group(0) @binding(10) var volume_d: texture_3d<f32>;
-@group(0) @binding(11) var minmax_a: texture_3d<u32>;
-@group(0) @binding(12) var minmax_b: texture_3d<u32>;
-@group(0) @binding(13) var minmax_c: texture_3d<u32>;
-@group(0) @binding(14) var minmax_d: texture_3d<u32>;
-@group(0) @binding(15) var volume_sampler: sampler;
-@group(0) @binding(16) var depth_texture: texture_depth_2d;
+@group(0) @binding(7) var volume_atlas: texture_3d<f32>;
+@group(0) @binding(8) var brick_atlas: texture_3d<u32>;
+@group(0) @binding(9) var volume_sampler: sampler;
+@group(0) @binding(10) var depth_texture: texture_depth_2d;

@@ -1,85 +1,27 @@
 #define_import_path focal::sampling
 
-// Sampling the volume slots like the reference's Sampler: trilinear at clamped
-// continuous voxel indices, central-difference gradients, nearest label codes, brick
-// occupancy and min-max (reference: volume::sample, volume::bricks).
+// Sampling volumes in the atlas like the reference's Sampler: trilinear at clamped
+// continuous voxel indices (the clamp keeps every filter tap inside the volume's own
+// box of the atlas), central-difference gradients, nearest label codes, brick occupancy
+// and min-max (reference: volume::sample, volume::bricks).
 
 #import focal::types::{Region, REGION_LABELS}
-#import focal::bindings::{volume_a, volume_b, volume_c, volume_d, minmax_a, minmax_b, minmax_c, minmax_d, volume_sampler, occupancy, lut_atlas}
-
-fn sample_slot(slot: u32, uvw: vec3<f32>) -> f32 {
-    switch slot {
-        case 0u: { return textureSampleLevel(volume_a, volume_sampler, uvw, 0.0).r; }
-        case 1u: { return textureSampleLevel(volume_b, volume_sampler, uvw, 0.0).r; }
-        case 2u: { return textureSampleLevel(volume_c, volume_sampler, uvw, 0.0).r; }
-        default: { return textureSampleLevel(volume_d, volume_sampler, uvw, 0.0).r; }
-    }
-}
-
-fn slot_texture_dims(slot: u32) -> vec3<f32> {
-    switch slot {
-        case 0u: { return vec3<f32>(textureDimensions(volume_a)); }
-        case 1u: { return vec3<f32>(textureDimensions(volume_b)); }
-        case 2u: { return vec3<f32>(textureDimensions(volume_c)); }
-        default: { return vec3<f32>(textureDimensions(volume_d)); }
-    }
-}
-
-fn load_slot(slot: u32, texel: vec3<i32>) -> f32 {
-    switch slot {
-        case 0u: { return textureLoad(volume_a, texel, 0).r; }
-        case 1u: { return textureLoad(volume_b, texel, 0).r; }
-        case 2u: { return textureLoad(volume_c, texel, 0).r; }
-        default: { return textureLoad(volume_d, texel, 0).r; }
-    }
-}
-
-fn minmax_slot(slot: u32, brick: vec3<i32>) -> vec2<u32> {
-    switch slot {
-        case 0u: { return textureLoad(minmax_a, brick, 0).rg; }
-        case 1u: { return textureLoad(minmax_b, brick, 0).rg; }
-        case 2u: { return textureLoad(minmax_c, brick, 0).rg; }
-        default: { return textureLoad(minmax_d, brick, 0).rg; }
-    }
-}
+#import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy, lut_atlas}
 
 // Trilinear sample (normalised) at continuous voxel index q, clamped to the edge voxels.
 fn trilinear(r: Region, q: vec3<f32>) -> f32 {
-    let dims = r.dims.xyz;
-    let c = clamp(q, vec3(0.0), dims - 1.0);
-    return sample_slot(r.slot, (c + 0.5) / dims);
+    let c = clamp(q, vec3(0.0), r.dims.xyz - 1.0);
+    return textureSampleLevel(volume_atlas, volume_sampler, (r.atlas_offset.xyz + c + 0.5) * scene.inv_atlas_size.xyz, 0.0).r;
 }
 
-// Code of the voxel nearest to q (label volumes); works on downsampled textures too.
+// Code of the voxel nearest to q (label volumes).
 fn nearest_code(r: Region, q: vec3<f32>) -> u32 {
-    let dims = r.dims.xyz;
-    let tex = slot_texture_dims(r.slot);
-    let c = clamp(floor(q + 0.5), vec3(0.0), dims - 1.0);
-    let texel = clamp(floor((c + 0.5) / dims * tex), vec3(0.0), tex - 1.0);
-    return u32(round(load_slot(r.slot, vec3<i32>(texel)) * r.dims.w));
+    let c = clamp(floor(q + 0.5), vec3(0.0), r.dims.xyz - 1.0);
+    return u32(round(textureLoad(volume_atlas, vec3<i32>(r.atlas_offset.xyz + c), 0).r * r.dims.w));
 }
 
 fn lut_texel(index: u32, atlas_width: u32) -> vec4<f32> {
     return textureLoad(lut_atlas, vec2<i32>(i32(index % atlas_width), i32(index / atlas_width)), 0);
-}
-
-// Central-difference gradient in normalised units per voxel (index axes). Label
-// volumes use the gradient of the label opacity field.
-fn index_gradient(r: Region, q: vec3<f32>, atlas_width: u32) -> vec3<f32> {
-    if (r.flags & REGION_LABELS) != 0u {
-        let ex = vec3(1.0, 0.0, 0.0);
-        let ey = vec3(0.0, 1.0, 0.0);
-        let ez = vec3(0.0, 0.0, 1.0);
-        return 0.5 * vec3(
-            label_alpha(r, q + ex, atlas_width) - label_alpha(r, q - ex, atlas_width),
-            label_alpha(r, q + ey, atlas_width) - label_alpha(r, q - ey, atlas_width),
-            label_alpha(r, q + ez, atlas_width) - label_alpha(r, q - ez, atlas_width),
-        );
-    }
-    let dx = trilinear(r, q + vec3(1.0, 0.0, 0.0)) - trilinear(r, q - vec3(1.0, 0.0, 0.0));
-    let dy = trilinear(r, q + vec3(0.0, 1.0, 0.0)) - trilinear(r, q - vec3(0.0, 1.0, 0.0));
-    let dz = trilinear(r, q + vec3(0.0, 0.0, 1.0)) - trilinear(r, q - vec3(0.0, 0.0, 1.0));
-    return 0.5 * vec3(dx, dy, dz);
 }
 
 fn label_alpha(r: Region, q: vec3<f32>, atlas_width: u32) -> f32 {
@@ -88,6 +30,28 @@ fn label_alpha(r: Region, q: vec3<f32>, atlas_width: u32) -> f32 {
         return 0.0;
     }
     return lut_texel(r.lut_offset + code, atlas_width).a;
+}
+
+// Central-difference gradient in normalised units per voxel (index axes). Label
+// volumes use the gradient of the label opacity field.
+fn index_gradient(r: Region, q: vec3<f32>, atlas_width: u32) -> vec3<f32> {
+    var g = vec3(0.0);
+#ifdef HAS_LABELS
+    if (r.flags & REGION_LABELS) != 0u {
+        for (var a = 0; a < 3; a++) {
+            var e = vec3(0.0);
+            e[a] = 1.0;
+            g[a] = label_alpha(r, q + e, atlas_width) - label_alpha(r, q - e, atlas_width);
+        }
+        return 0.5 * g;
+    }
+#endif
+    for (var a = 0; a < 3; a++) {
+        var e = vec3(0.0);
+        e[a] = 1.0;
+        g[a] = trilinear(r, q + e) - trilinear(r, q - e);
+    }
+    return 0.5 * g;
 }
 
 // The brick holding q (reference: BrickGrid::brick_at).
@@ -121,13 +85,8 @@ fn brick_exit(r: Region, q: vec3<f32>, qd: vec3<f32>, t: f32) -> f32 {
     return t + max(exit, 0.0);
 }
 
-// Largest normalised value in q's brick (for MIP skipping).
-fn brick_max(r: Region, q: vec3<f32>) -> f32 {
-    let b = brick_of(r, q);
-    return f32(minmax_slot(r.slot, vec3<i32>(b)).y) / r.dims.w;
-}
-
-fn brick_min(r: Region, q: vec3<f32>) -> f32 {
-    let b = brick_of(r, q);
-    return f32(minmax_slot(r.slot, vec3<i32>(b)).x) / r.dims.w;
+// Code range of q's brick, normalised.
+fn brick_range(r: Region, q: vec3<f32>) -> vec2<f32> {
+    let b = brick_of(r, q) + r.brick_offset.xyz;
+    return vec2<f32>(textureLoad(brick_atlas, vec3<i32>(b), 0).rg) / r.dims.w;
 }

@@ -9,9 +9,10 @@ struct Region {
     dims: vec4<f32>,
     shading: vec4<f32>,
     bricks: vec4<u32>,
+    atlas_offset: vec4<f32>,
+    brick_offset: vec4<u32>,
     plane_offset: u32,
     plane_count: u32,
-    slot: u32,
     mode: u32,
     flags: u32,
     lut_offset: u32,
@@ -25,6 +26,7 @@ struct Region {
     gradient_max: f32,
     pad_a: f32,
     pad_b: f32,
+    pad_c: f32,
 }
 
 struct Settings {
@@ -35,6 +37,7 @@ struct Settings {
 }
 
 struct SceneInfo {
+    inv_atlas_size: vec4<f32>,
     region_count: u32,
     lut_atlas_width: u32,
     pad_a: u32,

@@ -47,6 +47,12 @@ pub struct RenderArgs {
     /// Jitter ray starts (removes wood-grain rings; adds fine noise).
     #[arg(long)]
     jitter: bool,
+    /// Do not skip empty bricks (for measurements; the image is the same).
+    #[arg(long)]
+    no_skip: bool,
+    /// Do not stop rays once they are opaque (for measurements).
+    #[arg(long)]
+    no_early_termination: bool,
     /// Turn Blinn-Phong shading off.
     #[arg(long)]
     no_shading: bool,
@@ -118,6 +124,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     let image = if args.cpu {
         let mut scene = RenderScene::single(volume, appearance);
         scene.jitter = args.jitter;
+        scene.skip_empty = !args.no_skip;
         render(&scene, &camera, w, h)?.to_image()?
     } else {
         let mut off = Offscreen::new(w, h, |app| {
@@ -125,7 +132,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         })?;
         off.world_mut().spawn((Dataset::new(volume, appearance), Transform::default()));
         off.set_camera(&camera);
-        off.set_view(VolumeView { jitter: args.jitter, ..Default::default() });
+        off.set_view(VolumeView {
+            jitter: args.jitter,
+            skip_empty: !args.no_skip,
+            early_termination: !args.no_early_termination,
+            ..Default::default()
+        });
         eprintln!("GPU: {}", off.adapter_name());
         off.capture()?
     };
@@ -157,6 +169,8 @@ pub fn run_default(volume: Option<&Path>, out: &Path) -> Result<(), String> {
         iso: None,
         jitter: true,
         no_shading: false,
+        no_skip: false,
+        no_early_termination: false,
         labels: false,
         raw: None,
         resolution: 256,

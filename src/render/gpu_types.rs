@@ -25,6 +25,28 @@ pub mod region_flags {
     pub const OCCUPANCY: u32 = 4;
 }
 
+/// Scene features: which parts of the shader a scene needs (shader defs).
+pub mod features {
+    pub const DVR: u32 = 1;
+    pub const GRADIENT_MODULATION: u32 = 2;
+    pub const LABELS: u32 = 4;
+    pub const PROJECTION: u32 = 8;
+    pub const ISO: u32 = 16;
+    pub const SHADING: u32 = 32;
+    pub const MULTI_REGION: u32 = 64;
+
+    /// Shader def names, by bit.
+    pub const NAMES: [(u32, &str); 7] = [
+        (DVR, "HAS_DVR"),
+        (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
+        (LABELS, "HAS_LABELS"),
+        (PROJECTION, "HAS_PROJECTION"),
+        (ISO, "HAS_ISO"),
+        (SHADING, "HAS_SHADING"),
+        (MULTI_REGION, "MULTI_REGION"),
+    ];
+}
+
 /// View settings flags.
 pub mod view_flags {
     pub const JITTER: u32 = 1;
@@ -46,9 +68,12 @@ pub struct GpuRegion {
     pub shading: Vec4,
     /// Brick grid dimensions (xyz) and brick size (w).
     pub bricks: UVec4,
+    /// Texel offset of the volume in the volume atlas (xyz).
+    pub atlas_offset: Vec4,
+    /// Offset of the brick grid in the brick atlas (xyz).
+    pub brick_offset: UVec4,
     pub plane_offset: u32,
     pub plane_count: u32,
-    pub slot: u32,
     pub mode: u32,
     pub flags: u32,
     pub lut_offset: u32,
@@ -62,6 +87,7 @@ pub struct GpuRegion {
     pub gradient_max: f32,
     pub pad_a: f32,
     pub pad_b: f32,
+    pub pad_c: f32,
 }
 
 /// Per-view settings.
@@ -77,6 +103,8 @@ pub struct GpuSettings {
 /// Per-scene facts.
 #[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
 pub struct GpuSceneInfo {
+    /// 1 / size of the volume atlas in texels (xyz).
+    pub inv_atlas_size: Vec4,
     pub region_count: u32,
     /// Width of the LUT atlas in texels.
     pub lut_atlas_width: u32,

@@ -22,10 +22,14 @@ use bevy::window::ExitCondition;
 use bevy::winit::WinitPlugin;
 
 use super::VolumeView;
+use super::pipeline::RaycastPipelineId;
+use super::upload::GpuScene;
 use crate::region::{Camera as FocalCamera, Projection as FocalProjection};
+use bevy::render::RenderApp;
+use bevy::render::render_resource::{CachedPipelineState, PipelineCache};
 
-/// Frames drawn after a change before the image is captured.
-const SETTLE_FRAMES: u32 = 3;
+/// Most frames to wait for the pipeline and the upload, and for a capture.
+const MAX_WAIT_FRAMES: u32 = 20;
 
 /// The Bevy camera components that show a Focal camera.
 pub fn camera_bundle(cam: &FocalCamera) -> (Transform, Projection) {
@@ -134,10 +138,43 @@ impl Offscreen {
         }
     }
 
+    /// The error of the ray-cast pipeline, if it failed to build (a broken shader must
+    /// fail the render, not yield a picture without the volume).
+    pub fn pipeline_error(&self) -> Option<String> {
+        let world = self.app.get_sub_app(RenderApp)?.world();
+        let cache = world.get_resource::<PipelineCache>()?;
+        let mut states = world.try_query::<&RaycastPipelineId>()?;
+        states.iter(world).find_map(|id| match cache.get_render_pipeline_state(id.0) {
+            CachedPipelineState::Err(e) => Some(format!("the ray-cast shader failed to build: {e}")),
+            _ => None,
+        })
+    }
+
+    /// Whether the last frame drew the volumes: the scene is uploaded and every view's
+    /// pipeline is built.
+    fn ready(&self) -> bool {
+        let Some(world) = self.app.get_sub_app(RenderApp).map(|a| a.world()) else { return false };
+        let (Some(cache), Some(scene)) = (world.get_resource::<PipelineCache>(), world.get_resource::<GpuScene>()) else { return false };
+        let Some(mut ids) = world.try_query::<&RaycastPipelineId>() else { return false };
+        let ids: Vec<_> = ids.iter(world).map(|id| id.0).collect();
+        scene.ready() && !ids.is_empty() && ids.iter().all(|&id| matches!(cache.get_render_pipeline_state(id), CachedPipelineState::Ok(_)))
+    }
+
     /// Renders and reads back the image (sRGB-encoded RGBA8).
     pub fn capture(&mut self) -> Result<image::RgbaImage, String> {
-        for _ in 0..SETTLE_FRAMES {
+        let mut frames = 0;
+        loop {
             self.update();
+            if let Some(e) = self.pipeline_error() {
+                return Err(e);
+            }
+            if self.ready() {
+                break;
+            }
+            frames += 1;
+            if frames >= MAX_WAIT_FRAMES {
+                return Err("the ray caster did not get ready (no volume uploaded or no pipeline)".into());
+            }
         }
         let captured: Arc<Mutex<Option<Image>>> = default();
         let sink = captured.clone();
@@ -146,7 +183,7 @@ impl Offscreen {
                 *slot = Some(ev.image.clone());
             }
         });
-        for _ in 0..10 {
+        for _ in 0..MAX_WAIT_FRAMES {
             self.update();
             let image = captured.lock().ok().and_then(|mut s| s.take());
             if let Some(image) = image {
@@ -159,8 +196,11 @@ impl Offscreen {
 
     /// Average wall-clock time of `frames` frames (after the scene settled).
     pub fn time_frames(&mut self, frames: u32) -> Duration {
-        for _ in 0..SETTLE_FRAMES {
+        for _ in 0..MAX_WAIT_FRAMES {
             self.update();
+            if self.ready() {
+                break;
+            }
         }
         let t = Instant::now();
         for _ in 0..frames.max(1) {

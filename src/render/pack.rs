@@ -1,19 +1,19 @@
 //! Packing a [`RenderScene`] into the GPU layout: one [`GpuRegion`] per region, the
 //! planes of all regions in one array, every lookup table in one RGBA atlas, the brick
-//! occupancy bits of all regions in one word array, and the volumes in texture slots.
+//! occupancy bits of all regions in one word array, and every volume (and brick
+//! min-max grid) at its place in one 3D texture atlas. One atlas instead of a texture
+//! per volume: WGSL cannot index textures dynamically without binding arrays (absent
+//! on software Vulkan), and a `switch` over texture slots in the inner loop multiplies
+//! the sampling code.
 //!
 //! Packing reuses the CPU reference's preparation ([`crate::reference::prepare`]), so
 //! both renderers classify, step and shade with the same numbers. It decides nothing.
 
-use glam::{Mat4, UVec4, Vec4};
+use glam::{Mat4, UVec3, Vec4};
 
 use super::gpu_types::{GpuRegion, mode, region_flags};
 use crate::reference::prepare::{PreparedLookup, PreparedRegion};
 use crate::region::{Mode, RenderScene};
-
-/// Volume texture slots of the ray-cast pass (WGSL cannot index textures dynamically
-/// without binding arrays, which software Vulkan lacks).
-pub const VOLUME_SLOTS: usize = 4;
 
 /// Width of the lookup-table atlas in texels.
 pub const LUT_ATLAS_WIDTH: u32 = 4096;
@@ -28,10 +28,49 @@ pub struct PackedScene {
     pub lut: Vec<[f32; 4]>,
     /// Occupancy bits (bit `i % 32` of word `i / 32` is brick `i`).
     pub occupancy: Vec<u32>,
-    /// Scene volume index held by each texture slot.
-    pub slots: Vec<usize>,
-    /// Regions left out, with the reason (more volumes than slots).
+    /// Scene volume indices placed in the atlases, in atlas order.
+    pub volumes: Vec<usize>,
+    /// Where each of `volumes` lies in the volume atlas.
+    pub atlas: Atlas,
+    /// Where each of `volumes`' brick grids lies in the brick atlas.
+    pub brick_atlas: Atlas,
+    /// Regions left out, with the reason (the atlas is full).
     pub dropped: Vec<String>,
+    /// Shader features the regions need ([`super::gpu_types::features`]).
+    pub features: u32,
+}
+
+/// Boxes placed in a 3D texture.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Atlas {
+    pub size: UVec3,
+    pub offsets: Vec<UVec3>,
+}
+
+/// Shelf packing: boxes stacked along z in columns, columns side by side along x, each
+/// axis at most `max` texels. Returns `None` when they do not fit.
+pub fn atlas_layout(sizes: &[UVec3], max: u32) -> Option<Atlas> {
+    let mut offsets = Vec::with_capacity(sizes.len());
+    let (mut column_x, mut column_w, mut z) = (0u32, 0u32, 0u32);
+    let mut size = UVec3::ONE;
+    for &b in sizes {
+        if b.max_element() > max {
+            return None;
+        }
+        if z + b.z > max {
+            column_x += column_w;
+            column_w = 0;
+            z = 0;
+        }
+        if column_x + b.x > max {
+            return None;
+        }
+        offsets.push(UVec3::new(column_x, 0, z));
+        z += b.z;
+        column_w = column_w.max(b.x);
+        size = size.max(UVec3::new(column_x + b.x, b.y, z));
+    }
+    Some(Atlas { size, offsets })
 }
 
 impl PackedScene {
@@ -52,25 +91,36 @@ fn mode_number(m: Mode) -> u32 {
     }
 }
 
-/// Packs `scene`.
-pub fn pack(scene: &RenderScene) -> Result<PackedScene, String> {
+/// Packs `scene` with atlases of at most `max_texture` texels per axis.
+pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String> {
     let prepared = crate::reference::prepare(scene)?;
     let mut out = PackedScene::default();
+    // Volumes in order of first use; those that no longer fit are dropped.
     for p in &prepared {
-        let slot = match out.slots.iter().position(|&v| v == p.region.volume) {
-            Some(s) => s,
-            None if out.slots.len() < VOLUME_SLOTS => {
-                out.slots.push(p.region.volume);
-                out.slots.len() - 1
+        if out.volumes.contains(&p.region.volume) {
+            continue;
+        }
+        let mut candidate = out.volumes.clone();
+        candidate.push(p.region.volume);
+        let dims: Vec<UVec3> = candidate.iter().map(|&v| scene.volumes[v].dims()).collect();
+        let bricks: Vec<UVec3> = candidate.iter().map(|&v| scene.volumes[v].bricks().dims).collect();
+        match (atlas_layout(&dims, max_texture), atlas_layout(&bricks, max_texture)) {
+            (Some(a), Some(b)) => {
+                out.volumes = candidate;
+                out.atlas = a;
+                out.brick_atlas = b;
             }
-            None => {
-                out.dropped.push(format!("region of '{}' left out: more than {VOLUME_SLOTS} volumes in one view", p.volume.name));
-                continue;
+            _ => {
+                out.dropped.push(format!("'{}' left out: the volumes of this view exceed one {max_texture}³ texture atlas", p.volume.name))
             }
-        };
-        let region = pack_region(p, slot as u32, &mut out);
+        }
+    }
+    for p in &prepared {
+        let Some(slot) = out.volumes.iter().position(|&v| v == p.region.volume) else { continue };
+        let region = pack_region(p, out.atlas.offsets[slot], out.brick_atlas.offsets[slot], &mut out);
         out.regions.push(region);
     }
+    out.features = scene_features(&out.regions);
     if out.lut.is_empty() {
         out.lut.push([0.0; 4]);
     }
@@ -85,7 +135,29 @@ pub fn pack(scene: &RenderScene) -> Result<PackedScene, String> {
     Ok(out)
 }
 
-fn pack_region(p: &PreparedRegion, slot: u32, out: &mut PackedScene) -> GpuRegion {
+/// The shader features a list of regions needs.
+pub fn scene_features(regions: &[GpuRegion]) -> u32 {
+    use super::gpu_types::features as f;
+    let mut bits = if regions.len() > 1 { f::MULTI_REGION } else { 0 };
+    for r in regions {
+        let labels = r.flags & region_flags::LABELS != 0;
+        bits |= match r.mode {
+            mode::MIP | mode::MIN_IP | mode::X_RAY if !labels => f::PROJECTION,
+            mode::ISO if !labels => f::ISO,
+            mode::GRADIENT_DVR if !labels => f::DVR | f::GRADIENT_MODULATION,
+            _ => f::DVR,
+        };
+        if labels {
+            bits |= f::LABELS;
+        }
+        if r.flags & region_flags::SHADING != 0 {
+            bits |= f::SHADING;
+        }
+    }
+    bits
+}
+
+fn pack_region(p: &PreparedRegion, atlas_offset: UVec3, brick_offset: UVec3, out: &mut PackedScene) -> GpuRegion {
     let plane_offset = out.planes.len() as u32;
     out.planes.extend(p.region.planes.iter().map(|pl| pl.normal.extend(pl.offset)));
     let lut_offset = out.lut.len() as u32;
@@ -107,10 +179,10 @@ fn pack_region(p: &PreparedRegion, slot: u32, out: &mut PackedScene) -> GpuRegio
         flags |= region_flags::SHADING;
     }
     let occupancy_offset = out.occupancy.len() as u32;
-    let mut bricks = UVec4::ZERO;
-    if let Some((grid, occ)) = &p.occupancy {
+    let grid = p.volume.bricks();
+    let bricks = grid.dims.extend(grid.size);
+    if let Some((_, occ)) = &p.occupancy {
         flags |= region_flags::OCCUPANCY;
-        bricks = grid.dims.extend(grid.size);
         let mut words = vec![0u32; occ.len().div_ceil(32)];
         for (i, &o) in occ.iter().enumerate() {
             if o {
@@ -127,9 +199,10 @@ fn pack_region(p: &PreparedRegion, slot: u32, out: &mut PackedScene) -> GpuRegio
         dims: p.volume.dims().as_vec3().extend(p.volume.code_max() as f32),
         shading: Vec4::new(s.ambient, s.diffuse, s.specular, s.shininess),
         bricks,
+        atlas_offset: atlas_offset.as_vec3().extend(0.0),
+        brick_offset: brick_offset.extend(0),
         plane_offset,
         plane_count: p.region.planes.len() as u32,
-        slot,
         mode: mode_number(p.mode),
         flags,
         lut_offset,
@@ -143,6 +216,7 @@ fn pack_region(p: &PreparedRegion, slot: u32, out: &mut PackedScene) -> GpuRegio
         gradient_max: p.gradient_max,
         pad_a: 0.0,
         pad_b: 0.0,
+        pad_c: 0.0,
     }
 }
 
@@ -156,14 +230,15 @@ mod tests {
     use crate::volume::phantom;
 
     #[test]
-    fn packs_regions_planes_luts_and_slots() {
+    fn packs_regions_planes_luts_and_the_atlas() {
         let v = Arc::new(phantom::sphere(16, 5.0).unwrap());
         let tf = presets::builtin("grayscale_ramp").unwrap();
         let mut scene = RenderScene::single(v.clone(), Appearance::new(Mode::Mip, tf.clone()));
         scene.regions.push(Region::volume_box(&v.grid, 0, 0).clipped(Plane::through(glam::Vec3::ZERO, glam::Vec3::X)));
-        let packed = pack(&scene).unwrap();
+        let packed = pack(&scene, 2048).unwrap();
         assert_eq!(packed.regions.len(), 2);
-        assert_eq!(packed.slots, vec![0]);
+        assert_eq!(packed.volumes, vec![0]);
+        assert_eq!(packed.atlas.size, UVec3::splat(16));
         assert_eq!((packed.regions[0].plane_offset, packed.regions[0].plane_count), (0, 6));
         assert_eq!((packed.regions[1].plane_offset, packed.regions[1].plane_count), (6, 7));
         assert_eq!(packed.regions[0].mode, mode::MIP);
@@ -171,23 +246,37 @@ mod tests {
         assert_eq!((packed.regions[1].lut_offset, packed.regions[1].lut_width), (256, 256));
         assert_eq!(packed.lut.len(), LUT_ATLAS_WIDTH as usize);
         assert_eq!(packed.regions[0].dims, glam::Vec4::new(16.0, 16.0, 16.0, 255.0));
+        use crate::render::gpu_types::features as f;
+        assert_eq!(packed.features, f::PROJECTION | f::SHADING | f::MULTI_REGION);
     }
 
     #[test]
-    fn more_volumes_than_slots_are_reported() {
+    fn shelf_layout_stacks_then_starts_columns() {
+        let a = atlas_layout(&[UVec3::new(4, 5, 6), UVec3::new(3, 2, 4), UVec3::new(2, 2, 5)], 10).unwrap();
+        // 6 + 4 = 10 fits the first column; the third box starts a column at x = 4.
+        assert_eq!(a.offsets, vec![UVec3::ZERO, UVec3::new(0, 0, 6), UVec3::new(4, 0, 0)]);
+        assert_eq!(a.size, UVec3::new(6, 5, 10));
+        assert!(atlas_layout(&[UVec3::new(11, 1, 1)], 10).is_none());
+        assert!(atlas_layout(&[UVec3::splat(8), UVec3::splat(8)], 10).is_none());
+    }
+
+    #[test]
+    fn volumes_beyond_the_atlas_are_reported() {
         let tf = presets::builtin("grayscale_ramp").unwrap();
         let mut scene = RenderScene::default();
         scene.appearances.push(Appearance::new(Mode::Dvr, tf));
-        for i in 0..(VOLUME_SLOTS + 1) {
+        for i in 0..3 {
             let v = Arc::new(phantom::sphere(8, 2.0).unwrap());
             scene.regions.push(Region::volume_box(&v.grid, i, 0));
             scene.volumes.push(v);
         }
-        let packed = pack(&scene).unwrap();
-        assert_eq!(packed.regions.len(), VOLUME_SLOTS);
-        assert_eq!(packed.dropped.len(), 1);
+        // A 16³ atlas holds two 8³ volumes stacked, not three (16 along x also fails).
+        let packed = pack(&scene, 16).unwrap();
+        assert_eq!(packed.regions.len(), 3, "three volumes fit as two columns");
+        let packed = pack(&scene, 12).unwrap();
+        assert_eq!(packed.regions.len(), 1);
+        assert_eq!(packed.dropped.len(), 2);
         // DVR regions carry their occupancy bits.
         assert!(packed.regions.iter().all(|r| r.flags & region_flags::OCCUPANCY != 0));
-        assert_eq!(packed.regions[1].occupancy_offset, 1);
     }
 }

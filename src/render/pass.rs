@@ -29,12 +29,11 @@ pub fn raycast_pass(
     else {
         return;
     };
-    let (Some(info), Some(regions), Some(planes), Some(occupancy), Some((_, lut))) =
-        (&scene.info, &scene.regions, &scene.planes, &scene.occupancy, &scene.lut)
+    let (Some(info), Some(regions), Some(planes), Some(occupancy), Some((_, lut)), Some(atlases)) =
+        (&scene.info, &scene.regions, &scene.planes, &scene.occupancy, &scene.lut, &scene.atlases)
     else {
         return;
     };
-    let s = &scene.slots;
     let bind_group = ctx.render_device().create_bind_group(
         "focal_raycast_bind_group",
         &cache.get_bind_group_layout(&pipeline.layout),
@@ -46,14 +45,8 @@ pub fn raycast_pass(
             planes.as_entire_binding(),
             occupancy.as_entire_binding(),
             lut,
-            &s[0].volume,
-            &s[1].volume,
-            &s[2].volume,
-            &s[3].volume,
-            &s[0].minmax,
-            &s[1].minmax,
-            &s[2].minmax,
-            &s[3].minmax,
+            &atlases.volumes,
+            &atlases.bricks,
             &pipeline.sampler,
             depth.view(),
         )),

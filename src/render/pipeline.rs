@@ -10,7 +10,7 @@ use bevy::render::renderer::RenderDevice;
 use bevy::render::view::{ExtractedView, ViewTarget, ViewUniform};
 use bevy::shader::Shader;
 
-use super::gpu_types::{GpuSceneInfo, GpuSettings};
+use super::gpu_types::{GpuSceneInfo, GpuSettings, features};
 
 /// Pipeline state shared by every view.
 #[derive(Resource)]
@@ -36,12 +36,6 @@ pub fn init_pipeline(mut commands: Commands, device: Res<RenderDevice>, fullscre
                 storage_buffer_read_only_sized(false, None),
                 texture_2d(float(false)),
                 texture_3d(float(true)),
-                texture_3d(float(true)),
-                texture_3d(float(true)),
-                texture_3d(float(true)),
-                texture_3d(TextureSampleType::Uint),
-                texture_3d(TextureSampleType::Uint),
-                texture_3d(TextureSampleType::Uint),
                 texture_3d(TextureSampleType::Uint),
                 sampler(SamplerBindingType::Filtering),
                 texture_depth_2d(),
@@ -60,10 +54,11 @@ pub fn init_pipeline(mut commands: Commands, device: Res<RenderDevice>, fullscre
     commands.insert_resource(RaycastPipeline { layout, sampler, fullscreen: fullscreen.clone(), shader: super::shaders::RAYCAST });
 }
 
-/// Pipeline variant: the view's colour format.
+/// Pipeline variant: the view's colour format and the scene's shader features.
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
 pub struct RaycastKey {
     format: TextureFormat,
+    features: u32,
 }
 
 impl SpecializedRenderPipeline for RaycastPipeline {
@@ -76,6 +71,7 @@ impl SpecializedRenderPipeline for RaycastPipeline {
             vertex: self.fullscreen.to_vertex_state(),
             fragment: Some(FragmentState {
                 shader: self.shader.clone(),
+                shader_defs: features::NAMES.iter().filter(|(bit, _)| key.features & bit != 0).map(|(_, name)| (*name).into()).collect(),
                 targets: vec![Some(ColorTargetState {
                     format: key.format,
                     // Premultiplied "over" onto the meshes already drawn.
@@ -98,10 +94,11 @@ pub fn prepare_pipelines(
     cache: Res<PipelineCache>,
     mut pipelines: ResMut<SpecializedRenderPipelines<RaycastPipeline>>,
     pipeline: Res<RaycastPipeline>,
+    scene: Res<super::upload::GpuScene>,
     views: Query<(Entity, &ViewTarget), (With<ExtractedView>, With<GpuSettings>)>,
 ) {
     for (entity, target) in &views {
-        let id = pipelines.specialize(&cache, &pipeline, RaycastKey { format: target.main_texture_format() });
+        let id = pipelines.specialize(&cache, &pipeline, RaycastKey { format: target.main_texture_format(), features: scene.features });
         commands.entity(entity).insert(RaycastPipelineId(id));
     }
 }

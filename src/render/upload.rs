@@ -1,9 +1,8 @@
-//! GPU resources of the scene: packed buffers, the lookup-table atlas and one 3D texture
-//! (plus brick min-max texture) per volume slot. Rebuilt only when the scene changes;
-//! volume textures are cached per volume and reused across scene changes.
+//! GPU resources of the scene: packed buffers, the lookup-table atlas, the volume atlas
+//! and the brick min-max atlas. Buffers are rebuilt when the scene changes; the 3D
+//! atlases only when the set of volumes changes (not when an appearance does).
 
-use std::collections::HashMap;
-use std::sync::{Arc, Weak};
+use std::sync::Arc;
 
 use bevy::prelude::*;
 use bevy::render::render_resource::encase::{StorageBuffer, UniformBuffer};
@@ -15,14 +14,14 @@ use bevy::render::renderer::{RenderAdapter, RenderDevice, RenderQueue};
 
 use super::extract::ExtractedScene;
 use super::gpu_types::GpuSceneInfo;
-use super::pack::{LUT_ATLAS_WIDTH, PackedScene, VOLUME_SLOTS, pack};
+use super::pack::{LUT_ATLAS_WIDTH, PackedScene, pack};
 use crate::region::RenderScene;
-use crate::volume::{Volume, Voxels};
+use crate::volume::Volume;
 
-/// A volume and its brick grid on the GPU.
-pub struct GpuVolumeTextures {
-    pub volume: TextureView,
-    pub minmax: TextureView,
+/// The 3D atlases of a set of volumes.
+pub struct GpuAtlases {
+    pub volumes: TextureView,
+    pub bricks: TextureView,
     _textures: (Texture, Texture),
 }
 
@@ -30,16 +29,17 @@ pub struct GpuVolumeTextures {
 #[derive(Resource, Default)]
 pub struct GpuScene {
     last: Option<RenderScene>,
-    cache: HashMap<usize, (Weak<Volume>, Arc<GpuVolumeTextures>)>,
-    dummy: Option<Arc<GpuVolumeTextures>>,
+    /// The volumes (by identity) the atlases hold, and the atlases.
+    atlas_key: Vec<usize>,
+    pub atlases: Option<GpuAtlases>,
     pub info: Option<Buffer>,
     pub regions: Option<Buffer>,
     pub planes: Option<Buffer>,
     pub occupancy: Option<Buffer>,
     pub lut: Option<(Texture, TextureView)>,
-    /// One entry per slot (dummies for unused slots).
-    pub slots: Vec<Arc<GpuVolumeTextures>>,
     pub region_count: u32,
+    /// Shader features the scene needs.
+    pub features: u32,
     /// Messages about regions that could not be drawn.
     pub dropped: Vec<String>,
 }
@@ -47,7 +47,7 @@ pub struct GpuScene {
 impl GpuScene {
     /// Whether everything the pass binds exists.
     pub fn ready(&self) -> bool {
-        self.info.is_some() && self.regions.is_some() && self.lut.is_some() && self.slots.len() == VOLUME_SLOTS
+        self.info.is_some() && self.regions.is_some() && self.lut.is_some() && self.atlases.is_some()
     }
 }
 
@@ -72,7 +72,7 @@ pub fn upload_scene(
     if gpu.last.as_ref().is_some_and(|last| same_scene(last, scene)) && gpu.ready() {
         return;
     }
-    let packed = match pack(scene) {
+    let packed = match pack(scene, device.limits().max_texture_dimension_3d) {
         Ok(p) => p,
         Err(e) => {
             error!("cannot draw the scene: {e}");
@@ -82,27 +82,15 @@ pub fn upload_scene(
     for d in &packed.dropped {
         warn!("{d}");
     }
-    let format16 = sixteen_bit_format(&adapter);
-    gpu.cache.retain(|_, (weak, _)| weak.strong_count() > 0);
-    let mut slots = Vec::with_capacity(VOLUME_SLOTS);
-    for &v in &packed.slots {
-        let volume = &scene.volumes[v];
-        let key = Arc::as_ptr(volume) as usize;
-        let textures = match gpu.cache.get(&key) {
-            Some((_, t)) => t.clone(),
-            None => {
-                let t = Arc::new(volume_textures(&device, &queue, volume, format16));
-                gpu.cache.insert(key, (Arc::downgrade(volume), t.clone()));
-                t
-            }
-        };
-        slots.push(textures);
+    let key: Vec<usize> = packed.volumes.iter().map(|&v| Arc::as_ptr(&scene.volumes[v]) as usize).collect();
+    if gpu.atlas_key != key || gpu.atlases.is_none() {
+        let volumes: Vec<&Volume> = packed.volumes.iter().map(|&v| scene.volumes[v].as_ref()).collect();
+        gpu.atlases = Some(atlases(&device, &queue, &volumes, &packed, sixteen_bit_format(&adapter)));
+        gpu.atlas_key = key;
     }
-    let dummy = gpu.dummy.get_or_insert_with(|| Arc::new(dummy_textures(&device, &queue))).clone();
-    slots.resize(VOLUME_SLOTS, dummy);
     write_buffers(&device, &queue, &packed, &mut gpu);
-    gpu.slots = slots;
     gpu.region_count = packed.regions.len() as u32;
+    gpu.features = packed.features;
     gpu.dropped = packed.dropped;
     gpu.last = Some(scene.clone());
 }
@@ -144,28 +132,57 @@ fn texture_3d(
     (texture, view)
 }
 
-/// The volume's codes as a texture (16-bit codes as normalised halves where `R16Unorm`
-/// is missing: `code / 65535` rounded to f16) and its brick min-max grid.
-fn volume_textures(device: &RenderDevice, queue: &RenderQueue, v: &Volume, format16: TextureFormat) -> GpuVolumeTextures {
-    let (format, data): (TextureFormat, std::borrow::Cow<[u8]>) = match (&v.voxels, format16) {
-        (Voxels::U8(d), _) => (TextureFormat::R8Unorm, d.as_slice().into()),
-        (Voxels::U16(_), TextureFormat::R16Unorm) => (TextureFormat::R16Unorm, v.voxels.as_bytes().into()),
-        (Voxels::U16(d), _) => {
-            let halves: Vec<u8> = d.iter().flat_map(|&c| half::f16::from_f32(c as f32 / 65535.0).to_le_bytes()).collect();
-            (TextureFormat::R16Float, halves.into())
+/// Copies `src` (x fastest, `dims`) into `dst` (`size`) at `offset`, `bpp` bytes a texel.
+fn blit(dst: &mut [u8], size: UVec3, src: &[u8], dims: UVec3, offset: UVec3, bpp: usize) {
+    let row = dims.x as usize * bpp;
+    for z in 0..dims.z {
+        for y in 0..dims.y {
+            let s = ((z * dims.y + y) * dims.x) as usize * bpp;
+            let d = ((((offset.z + z) * size.y + offset.y + y) * size.x + offset.x) as usize) * bpp;
+            dst[d..d + row].copy_from_slice(&src[s..s + row]);
         }
-    };
-    let (vt, vv) = texture_3d(device, queue, &format!("focal volume {}", v.name), v.dims(), format, &data);
-    let bricks = v.bricks();
-    let minmax: Vec<u8> = bricks.min.iter().zip(&bricks.max).flat_map(|(&lo, &hi)| [lo.to_le_bytes(), hi.to_le_bytes()].concat()).collect();
-    let (mt, mv) = texture_3d(device, queue, "focal brick min-max", bricks.dims, TextureFormat::Rg16Uint, &minmax);
-    GpuVolumeTextures { volume: vv, minmax: mv, _textures: (vt, mt) }
+    }
 }
 
-fn dummy_textures(device: &RenderDevice, queue: &RenderQueue) -> GpuVolumeTextures {
-    let (vt, vv) = texture_3d(device, queue, "focal empty volume", UVec3::ONE, TextureFormat::R8Unorm, &[0]);
-    let (mt, mv) = texture_3d(device, queue, "focal empty bricks", UVec3::ONE, TextureFormat::Rg16Uint, &[0; 4]);
-    GpuVolumeTextures { volume: vv, minmax: mv, _textures: (vt, mt) }
+/// The volume atlas (8-bit when every volume is, else 16-bit: 8-bit codes `c` become
+/// `257·c`, the same normalised value; `R16Float` halves `code / 65535` where
+/// `R16Unorm` is missing) and the brick min-max atlas (`Rg16Uint`, codes as stored).
+fn atlases(device: &RenderDevice, queue: &RenderQueue, volumes: &[&Volume], packed: &PackedScene, format16: TextureFormat) -> GpuAtlases {
+    let size = packed.atlas.size;
+    let texels = (size.x * size.y * size.z) as usize;
+    let sixteen = volumes.iter().any(|v| v.voxels.bits() == 16);
+    let (format, data) = if !sixteen {
+        let mut data = vec![0u8; texels];
+        for (v, &o) in volumes.iter().zip(&packed.atlas.offsets) {
+            blit(&mut data, size, v.voxels.as_bytes(), v.dims(), o, 1);
+        }
+        (TextureFormat::R8Unorm, data)
+    } else {
+        let mut data = vec![0u8; texels * 2];
+        for (v, &o) in volumes.iter().zip(&packed.atlas.offsets) {
+            let scale = if v.voxels.bits() == 8 { 257 } else { 1 };
+            let encode = |c: u16| -> [u8; 2] {
+                let c = c as u32 * scale;
+                match format16 {
+                    TextureFormat::R16Unorm => (c as u16).to_le_bytes(),
+                    _ => half::f16::from_f32(c as f32 / 65535.0).to_le_bytes(),
+                }
+            };
+            let bytes: Vec<u8> = (0..v.voxels.len()).flat_map(|i| encode(v.voxels.code(i))).collect();
+            blit(&mut data, size, &bytes, v.dims(), o, 2);
+        }
+        (format16, data)
+    };
+    let (vt, vv) = texture_3d(device, queue, "focal volume atlas", size, format, &data);
+    let bsize = packed.brick_atlas.size;
+    let mut bricks = vec![0u8; (bsize.x * bsize.y * bsize.z) as usize * 4];
+    for (v, &o) in volumes.iter().zip(&packed.brick_atlas.offsets) {
+        let g = v.bricks();
+        let pairs: Vec<u8> = g.min.iter().zip(&g.max).flat_map(|(&lo, &hi)| [lo.to_le_bytes(), hi.to_le_bytes()].concat()).collect();
+        blit(&mut bricks, bsize, &pairs, g.dims, o, 4);
+    }
+    let (bt, bv) = texture_3d(device, queue, "focal brick atlas", bsize, TextureFormat::Rg16Uint, &bricks);
+    GpuAtlases { volumes: vv, bricks: bv, _textures: (vt, bt) }
 }
 
 fn storage<T: bevy::render::render_resource::ShaderType + bevy::render::render_resource::encase::internal::WriteInto>(
@@ -184,7 +201,14 @@ fn storage<T: bevy::render::render_resource::ShaderType + bevy::render::render_r
 }
 
 fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScene, gpu: &mut GpuScene) {
-    let info = GpuSceneInfo { region_count: packed.regions.len() as u32, lut_atlas_width: LUT_ATLAS_WIDTH, pad_a: 0, pad_b: 0 };
+    let inv = 1.0 / packed.atlas.size.max(UVec3::ONE).as_vec3();
+    let info = GpuSceneInfo {
+        inv_atlas_size: inv.extend(0.0),
+        region_count: packed.regions.len() as u32,
+        lut_atlas_width: LUT_ATLAS_WIDTH,
+        pad_a: 0,
+        pad_b: 0,
+    };
     let mut ub = UniformBuffer::new(Vec::new());
     let _ = ub.write(&info);
     gpu.info = Some(device.create_buffer_with_data(&BufferInitDescriptor {
