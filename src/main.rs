@@ -33,7 +33,7 @@ fn main() -> ExitCode {
     let result = match args.command {
         Some(Command::Info(a)) => cli::info::run(&a),
         Some(Command::Render(a)) => cli::render::run(&a),
-        None => cli::render::run_default(args.volume.as_deref(), &args.out),
+        None => cli::render::run_headless(args.volume.as_deref(), &args.out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

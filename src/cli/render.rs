@@ -1,52 +1,61 @@
-//! `focal render`: a volume or phantom to PNG with the CPU reference renderer.
+//! `focal render`: scene files, or one data file with options, to PNG (GPU by default,
+//! `--cpu` for the reference renderer).
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::time::Instant;
 
-use bevy::prelude::Transform;
 use clap::Args;
-use focal::FocalPlugins;
-use focal::dataset::Dataset;
-use focal::reference::{RenderScene, render};
-use focal::region::{Appearance, Lookup, Mode, View};
-use focal::render::VolumeView;
-use focal::render::headless::Offscreen;
-use focal::transfer::{LabelTransfer, Lut, presets};
-use focal::volume::readers::RawSpec;
-use focal::volume::{LabelTable, LabelVolume};
+use focal::region::{Mode, Shading, View};
+use focal::scene::file::{AppearanceSpec, CameraSpec, DatasetSpec, LabelsSpec, RenderingSpec, SceneFile, SourceSpec};
+use focal::scene::run::{RunOptions, render_frames, render_scene_file};
+use focal::volume::phantom::Phantom;
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Volume file, DICOM folder or `phantom:head|engine|sphere` (default: the head phantom).
-    input: Option<PathBuf>,
+    /// Scene files (`.ron`), or one volume file, DICOM folder or `phantom:head|engine|sphere`
+    /// (default: the head phantom).
+    inputs: Vec<PathBuf>,
     /// Render on the CPU with the reference renderer instead of the GPU.
     #[arg(long)]
     cpu: bool,
+    /// Output: a folder for scene files (default `out/`), a PNG for a data file
+    /// (default `out/render.png`).
+    #[arg(long, short)]
+    out: Option<PathBuf>,
+    /// Image size WIDTHxHEIGHT (default: the scene's, or 512x512).
+    #[arg(long)]
+    size: Option<String>,
     /// Transfer-function preset name or `.ron` file (default: chosen for the data).
     #[arg(long)]
     preset: Option<String>,
     /// dvr, mip, minip, xray, gradient_dvr or iso.
     #[arg(long, default_value = "dvr")]
     mode: Mode,
-    /// View: anterior/front, posterior, left, right, superior/top, inferior, oblique.
+    /// View direction: +x/right, -x/left, +y/anterior/front, -y/posterior, +z/superior/top,
+    /// -z/inferior, oblique.
     #[arg(long, default_value = "oblique")]
     view: View,
+    /// Azimuth in degrees around the superior axis, from the anterior side (with
+    /// --elevation, instead of --view).
+    #[arg(long, allow_hyphen_values = true)]
+    azimuth: Option<f32>,
+    /// Elevation in degrees above the axial plane.
+    #[arg(long, allow_hyphen_values = true)]
+    elevation: Option<f32>,
     /// Orthographic projection instead of perspective.
     #[arg(long)]
     ortho: bool,
-    /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "512x512")]
-    size: String,
+    /// Zoom factor (> 1 moves closer).
+    #[arg(long, default_value_t = 1.0)]
+    zoom: f32,
     /// Sample distance in units of the smallest voxel spacing.
     #[arg(long, default_value_t = 0.5)]
     step: f32,
     /// Iso-value in the data's units (iso mode; default: the middle of the value range).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     iso: Option<f64>,
-    /// Jitter ray starts (removes wood-grain rings; adds fine noise).
+    /// Do not jitter ray starts.
     #[arg(long)]
-    jitter: bool,
+    no_jitter: bool,
     /// Do not skip empty bricks (for measurements; the image is the same).
     #[arg(long)]
     no_skip: bool,
@@ -61,13 +70,10 @@ pub struct RenderArgs {
     labels: bool,
     /// Layout of headerless raw files: DIMS:TYPE[:le|be][:s=SPACING][:skip=BYTES].
     #[arg(long)]
-    raw: Option<RawSpec>,
+    raw: Option<String>,
     /// Resolution of generated phantoms.
     #[arg(long, default_value_t = 256)]
     resolution: u32,
-    /// Output PNG.
-    #[arg(long, short, default_value = "out/render.png")]
-    out: PathBuf,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -79,73 +85,80 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
-    let (w, h) = parse_size(&args.size)?;
-    let t = Instant::now();
-    let volume = super::load(args.input.as_deref(), args.raw.as_ref(), args.resolution)?;
-    eprintln!("loaded {} ({}) in {:.2} s", volume.name, focal::volume::grid::fmt_dims(volume.dims()), t.elapsed().as_secs_f32());
-    let labels;
-    let (target, lookup) = if args.labels {
-        let table = match &args.input {
-            Some(p) => focal::volume::readers::label_table::read_sidecars(p).map_err(|e| e.to_string())?,
-            None => LabelTable::default(),
-        };
-        labels = LabelVolume::from_volume(volume, table)?;
-        let ids = labels.present_ids().into_iter().map(|(id, _)| id);
-        let lookup = Lookup::Labels(LabelTransfer::from_table(&labels.table, ids, 0.6));
-        (&labels.volume, lookup)
-    } else {
-        labels = LabelVolume { volume, table: LabelTable::default() };
-        let tf = match &args.preset {
-            Some(p) => presets::load(p)?,
-            None if args.mode.is_projection() => presets::builtin("grayscale_ramp")?,
-            None => presets::default_for(&labels.volume)?,
-        };
-        (&labels.volume, Lookup::Transfer(tf))
-    };
-    let mut appearance = Appearance { lookup, ..Appearance::new(args.mode, presets::builtin("grayscale_ramp")?) };
-    appearance.step = args.step;
-    appearance.shading.enabled = !args.no_shading;
-    appearance.iso_value = args.iso.unwrap_or((target.stats.min + target.stats.max) * 0.5);
-    let volume = Arc::new(target.clone());
-    // Frame what the transfer function shows (the whole box for projections).
-    let visible = match (&appearance.lookup, args.mode.is_projection()) {
-        (Lookup::Transfer(tf), false) => Lut::for_volume(tf, target).visible_bounds(target),
-        (Lookup::Labels(styles), _) => {
-            let table = styles.bake(target.stats.code_max as usize + 1);
-            let bricks = target.bricks();
-            let keep = bricks.occupancy(|lo, hi| table[lo as usize..=hi as usize].iter().any(|c| c[3] > 0.0));
-            bricks.bounds_where(&keep).map(|(lo, hi)| target.grid.index_box_world_bounds(lo, hi))
+    let size = args.size.as_deref().map(parse_size).transpose()?;
+    let options = |out_dir: PathBuf| RunOptions { out_dir, cpu: args.cpu, size };
+    let scenes: Vec<&PathBuf> = args.inputs.iter().filter(|p| p.extension().is_some_and(|e| e == "ron")).collect();
+    if !scenes.is_empty() {
+        if scenes.len() != args.inputs.len() {
+            return Err("give either scene files (.ron) or one data file, not both".into());
         }
-        _ => None,
-    };
-    let (lo, hi) = visible.unwrap_or_else(|| target.grid.world_bounds());
-    let camera = args.view.frame_box(lo, hi, w as f32 / h as f32, args.ortho);
-    let t = Instant::now();
-    let image = if args.cpu {
-        let mut scene = RenderScene::single(volume, appearance);
-        scene.jitter = args.jitter;
-        scene.skip_empty = !args.no_skip;
-        render(&scene, &camera, w, h)?.to_image()?
-    } else {
-        let mut off = Offscreen::new(w, h, |app| {
-            app.add_plugins(FocalPlugins);
-        })?;
-        off.world_mut().spawn((Dataset::new(volume, appearance), Transform::default()));
-        off.set_camera(&camera);
-        off.set_view(VolumeView {
-            jitter: args.jitter,
-            skip_empty: !args.no_skip,
-            early_termination: !args.no_early_termination,
-            ..Default::default()
-        });
-        eprintln!("GPU: {}", off.adapter_name());
-        off.capture()?
-    };
-    eprintln!("rendered {w}×{h} in {:.2} s", t.elapsed().as_secs_f32());
-    write(&image, &args.out)
+        let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("out"));
+        for s in scenes {
+            let t = std::time::Instant::now();
+            for p in render_scene_file(s, &options(dir.clone()))? {
+                println!("{}", p.display());
+            }
+            eprintln!("{}: {:.1} s", s.display(), t.elapsed().as_secs_f32());
+        }
+        return Ok(());
+    }
+    if args.inputs.len() > 1 {
+        return Err("give one data file (or several .ron scene files)".into());
+    }
+    let scene = scene_for(args.inputs.first().map(PathBuf::as_path), args)?;
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out/render.png"));
+    let images = render_frames(scene, Path::new("."), &options(PathBuf::new()))?;
+    let (_, image) = images.into_iter().next().ok_or("nothing rendered")?;
+    save(&image, &out)
 }
 
-fn write(image: &image::RgbaImage, out: &Path) -> Result<(), String> {
+/// A one-dataset scene from the command-line options.
+fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, String> {
+    let source = match input {
+        None => SourceSpec::Phantom { kind: Phantom::Head, resolution: args.resolution },
+        Some(p) if p.to_string_lossy().starts_with("phantom:") => {
+            SourceSpec::Phantom { kind: p.to_string_lossy()["phantom:".len()..].parse()?, resolution: args.resolution }
+        }
+        Some(p) => match &args.raw {
+            Some(layout) => SourceSpec::Raw { path: p.to_path_buf(), layout: layout.clone() },
+            None => SourceSpec::File(p.to_path_buf()),
+        },
+    };
+    let shading = args.no_shading.then(|| Shading { enabled: false, ..Default::default() });
+    let appearance = AppearanceSpec {
+        mode: args.mode,
+        preset: args.preset.clone(),
+        transfer: None,
+        labels: args.labels.then(LabelsSpec::default),
+        shading,
+        step: args.step,
+        iso: args.iso,
+    };
+    let camera = match (args.azimuth, args.elevation) {
+        (None, None) => CameraSpec::View { view: args.view, orthographic: args.ortho, zoom: args.zoom },
+        (a, e) => {
+            CameraSpec::Orbit { azimuth_deg: a.unwrap_or(0.0), elevation_deg: e.unwrap_or(0.0), orthographic: args.ortho, zoom: args.zoom }
+        }
+    };
+    Ok(SceneFile {
+        size: (512, 512),
+        background: (0.0, 0.0, 0.0),
+        light: Default::default(),
+        rendering: RenderingSpec { jitter: !args.no_jitter, skip_empty: !args.no_skip, early_termination: !args.no_early_termination },
+        datasets: vec![DatasetSpec {
+            name: None,
+            source,
+            appearance,
+            translation: (0.0, 0.0, 0.0),
+            rotation_deg: (0.0, 0.0, 0.0),
+            visible: true,
+        }],
+        camera,
+        frames: Vec::new(),
+    })
+}
+
+fn save(image: &image::RgbaImage, out: &Path) -> Result<(), String> {
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     }
@@ -154,27 +167,29 @@ fn write(image: &image::RgbaImage, out: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// `focal [VOLUME]` without a window (the app comes with the GPU renderer): renders
-/// the default view of the volume, or of the head phantom, to `out`.
-pub fn run_default(volume: Option<&Path>, out: &Path) -> Result<(), String> {
-    let args = RenderArgs {
-        input: volume.map(Path::to_path_buf),
-        cpu: false,
-        preset: None,
-        mode: Mode::Dvr,
-        view: View::Oblique,
-        ortho: false,
-        size: "512x512".into(),
-        step: 0.5,
-        iso: None,
-        jitter: true,
-        no_shading: false,
-        no_skip: false,
-        no_early_termination: false,
-        labels: false,
-        raw: None,
-        resolution: 256,
-        out: out.to_path_buf(),
+/// The default scene (the head phantom), embedded.
+pub const DEFAULT_SCENE: &str = include_str!("../../assets/scenes/default.ron");
+
+/// `focal [VOLUME]` on a machine without a display: renders the default scene (or the
+/// volume with its default look) to `out` and says where.
+pub fn run_headless(volume: Option<&Path>, out: &Path) -> Result<(), String> {
+    let scene = match volume {
+        None => SceneFile::parse(DEFAULT_SCENE, "assets/scenes/default.ron")?,
+        Some(v) => {
+            let mut s = SceneFile::parse(DEFAULT_SCENE, "assets/scenes/default.ron")?;
+            s.datasets = vec![DatasetSpec {
+                name: None,
+                source: SourceSpec::File(v.to_path_buf()),
+                appearance: AppearanceSpec::default(),
+                translation: (0.0, 0.0, 0.0),
+                rotation_deg: (0.0, 0.0, 0.0),
+                visible: true,
+            }];
+            s
+        }
     };
-    run(&args)
+    let images = render_frames(scene, Path::new("."), &RunOptions::default())?;
+    let (_, image) = images.into_iter().next().ok_or("nothing rendered")?;
+    eprintln!("no display: rendered the default view headless");
+    save(&image, out)
 }

@@ -71,14 +71,9 @@ pub fn collect_regions(
         }
         let volume = gpu.map(|g| g.volume.clone()).unwrap_or_else(|| d.volume.clone());
         let index = scene.volumes.len();
-        let mut region = Region::volume_box(&volume.grid, index, index);
-        // A dataset moved by `transform`: world → dataset space → voxel.
-        let to_local = transform.affine().inverse();
-        region.world_to_voxel = volume.grid.world_to_index() * to_local;
-        region.planes = crate::region::box_planes(&region.world_to_voxel, Vec3::splat(-0.5), volume.dims().as_vec3() - 0.5);
+        scene.regions.push(Region::volume_box_at(&volume.grid, transform.affine(), index, index));
         scene.volumes.push(volume);
         scene.appearances.push(d.appearance.clone());
-        scene.regions.push(region);
     }
     out.scene = scene;
 }

@@ -3,7 +3,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::transfer::{LabelTransfer, TransferFunction};
+use glam::Vec3;
+
+use crate::transfer::{LabelTransfer, Lut, TransferFunction};
+use crate::volume::Volume;
 
 /// Rendering modes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -15,8 +18,10 @@ pub enum Mode {
     /// Maximum intensity projection.
     Mip,
     /// Minimum intensity projection.
+    #[serde(rename = "minip")]
     MinIp,
     /// Average along the ray (a simulated radiograph).
+    #[serde(rename = "xray")]
     XRay,
     /// DVR with opacity scaled by the normalised gradient magnitude.
     GradientDvr,
@@ -105,5 +110,26 @@ pub struct Appearance {
 impl Appearance {
     pub fn new(mode: Mode, tf: TransferFunction) -> Self {
         Self { mode, lookup: Lookup::Transfer(tf), shading: Shading::default(), step: 0.5, iso_value: 0.0 }
+    }
+
+    /// World-space bounds of what this appearance shows of `volume` (the bricks with any
+    /// opacity; the whole box for projections, which show every sample).
+    pub fn visible_bounds(&self, volume: &Volume) -> Option<(Vec3, Vec3)> {
+        let bricks = volume.bricks();
+        let keep = match (&self.lookup, self.mode.is_projection()) {
+            (Lookup::Transfer(_), true) => return Some(volume.grid.world_bounds()),
+            (Lookup::Transfer(tf), false) => {
+                let lut = Lut::for_volume(tf, volume);
+                let map = &volume.values;
+                bricks.occupancy(|lo, hi| lut.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0)
+            }
+            (Lookup::Labels(styles), _) => {
+                let table = styles.bake(volume.stats.code_max as usize + 1);
+                bricks.occupancy(|lo, hi| table.get(lo as usize..=hi as usize).is_some_and(|t| t.iter().any(|c| c[3] > 0.0)))
+            }
+        };
+        bricks
+            .bounds_where(&keep)
+            .map(|(lo, hi)| volume.grid.index_box_world_bounds(lo.max(Vec3::splat(-0.5)), hi.min(volume.dims().as_vec3() - 0.5)))
     }
 }

@@ -165,20 +165,52 @@ impl View {
     }
 }
 
+/// A camera orbiting a target: azimuth around the superior (+z) axis, measured from the
+/// anterior side (azimuth 0° looks at the face, 90° at the patient's left side),
+/// elevation above the axial plane. Direction from the target to the eye:
+/// `(−sin az·cos el, cos az·cos el, sin el)`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Orbit {
+    pub target: Vec3,
+    pub azimuth_deg: f32,
+    pub elevation_deg: f32,
+    pub distance: f32,
+    pub projection: Projection,
+}
+
+impl Orbit {
+    /// Unit direction from the target to the eye.
+    pub fn direction(&self) -> Vec3 {
+        let (az, el) = (self.azimuth_deg.to_radians(), self.elevation_deg.to_radians());
+        Vec3::new(-az.sin() * el.cos(), az.cos() * el.cos(), el.sin())
+    }
+
+    pub fn camera(&self) -> Camera {
+        let dir = self.direction();
+        // Looking straight down or up, "up" is anterior instead of superior.
+        let up = if dir.z.abs() > 0.999 { Vec3::Y * -dir.z.signum() } else { Vec3::Z };
+        Camera::look_at(self.target + dir * self.distance, self.target, up, self.projection)
+    }
+}
+
 impl std::str::FromStr for View {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         let s = s.trim().to_ascii_lowercase();
         let alias = match s.as_str() {
-            "front" => "anterior",
-            "back" => "posterior",
-            "top" => "superior",
-            "bottom" => "inferior",
+            "front" | "+y" | "y" => "anterior",
+            "back" | "-y" => "posterior",
+            "top" | "+z" | "z" => "superior",
+            "bottom" | "-z" => "inferior",
+            "+x" | "x" => "right",
+            "-x" => "left",
             "iso" | "three_quarter" => "oblique",
             other => other,
         };
         View::ALL.into_iter().find(|v| v.name() == alias).ok_or_else(|| {
-            format!("unknown view '{s}' (anterior/front, posterior/back, left, right, superior/top, inferior/bottom, oblique)")
+            format!(
+                "unknown view '{s}' (anterior/front/+y, posterior/back/-y, left/-x, right/+x, superior/top/+z, inferior/bottom/-z, oblique)"
+            )
         })
     }
 }
@@ -232,6 +264,25 @@ mod tests {
             }
             assert!(widest > 0.9, "{ortho}: {widest}");
         }
+    }
+
+    #[test]
+    fn orbit_angles_follow_the_convention() {
+        let o = Orbit {
+            target: Vec3::ZERO,
+            azimuth_deg: 0.0,
+            elevation_deg: 0.0,
+            distance: 10.0,
+            projection: Projection::Perspective { fov_y: 0.5 },
+        };
+        assert!((o.camera().position - Vec3::new(0.0, 10.0, 0.0)).length() < 1e-5);
+        let left = Orbit { azimuth_deg: 90.0, ..o };
+        assert!((left.camera().position - Vec3::new(-10.0, 0.0, 0.0)).length() < 1e-4);
+        let top = Orbit { elevation_deg: 90.0, ..o };
+        let cam = top.camera();
+        assert!((cam.position - Vec3::new(0.0, 0.0, 10.0)).length() < 1e-4);
+        assert!((cam.forward() + Vec3::Z).length() < 1e-4);
+        assert_eq!("-x".parse::<View>().unwrap(), View::Left);
     }
 
     /// Normalised device coordinates of a world point.

@@ -15,7 +15,7 @@ pub mod scene;
 use glam::{Affine3A, Vec3};
 
 pub use appearance::{Appearance, Light, Lookup, Mode, Shading};
-pub use camera::{Camera, Projection, Ray, View};
+pub use camera::{Camera, Orbit, Projection, Ray, View};
 pub use scene::RenderScene;
 
 use crate::volume::Grid;
@@ -60,7 +60,13 @@ pub struct Region {
 impl Region {
     /// The box of a volume's voxel cells, showing that volume in place.
     pub fn volume_box(grid: &Grid, volume: usize, appearance: usize) -> Region {
-        let world_to_voxel = grid.world_to_index();
+        Self::volume_box_at(grid, Affine3A::IDENTITY, volume, appearance)
+    }
+
+    /// The box of a volume's voxel cells placed in the world by `transform` (the volume's
+    /// own space → world).
+    pub fn volume_box_at(grid: &Grid, transform: Affine3A, volume: usize, appearance: usize) -> Region {
+        let world_to_voxel = grid.world_to_index() * transform.inverse();
         Region { planes: box_planes(&world_to_voxel, Vec3::splat(-0.5), grid.dims.as_vec3() - 0.5), world_to_voxel, volume, appearance }
     }
 
@@ -156,6 +162,11 @@ mod tests {
         let c = r.clipped(Plane::through(Vec3::new(0.0, 1.0, 0.0), Vec3::Y));
         let (_, t1) = c.intersect(Vec3::new(0.0, -10.0, 0.5), Vec3::Y).unwrap();
         assert!((t1 - 11.0).abs() < 1e-5);
+        // Moved 5 mm along y: the box moves with it, and so does the voxel map.
+        let moved = Region::volume_box_at(&g, Affine3A::from_translation(Vec3::Y * 5.0), 0, 0);
+        let (t0, _) = moved.intersect(Vec3::new(0.0, -10.0, 0.5), Vec3::Y).unwrap();
+        assert!((t0 - 14.5).abs() < 1e-5, "{t0}");
+        assert!((moved.world_to_voxel.transform_point3(Vec3::new(0.0, 5.0, 0.0)) - Vec3::ZERO).length() < 1e-5);
         assert_eq!(Plane::through(Vec3::ONE, Vec3::X).flipped().distance(Vec3::ZERO), 1.0);
     }
 }

@@ -61,14 +61,21 @@ impl Offscreen {
             return Err(format!("image size {width}×{height} is not 1..16384 on each side"));
         }
         let mut app = App::new();
-        app.add_plugins(
-            DefaultPlugins
-                .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
-                .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() })
-                .disable::<WinitPlugin>()
-                // One update = one rendered frame, so a GPU wait covers the frame just updated.
-                .disable::<PipelinedRenderingPlugin>(),
-        );
+        let defaults = DefaultPlugins
+            .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
+            .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() })
+            .disable::<WinitPlugin>()
+            // One update = one rendered frame, so a GPU wait covers the frame just updated.
+            .disable::<PipelinedRenderingPlugin>();
+        // The global logger can be installed once per process.
+        static LOGGER: std::sync::Once = std::sync::Once::new();
+        let mut first = false;
+        LOGGER.call_once(|| first = true);
+        if first {
+            app.add_plugins(defaults);
+        } else {
+            app.add_plugins(defaults.disable::<bevy::log::LogPlugin>());
+        }
         plugins(&mut app);
         app.finish();
         app.cleanup();

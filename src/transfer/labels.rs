@@ -9,7 +9,7 @@ use super::color::srgb3_to_linear;
 use crate::volume::LabelTable;
 
 /// How one label is drawn.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LabelStyle {
     pub color: [f32; 3],
     pub opacity: f32,

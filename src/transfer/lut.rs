@@ -91,16 +91,6 @@ impl Lut {
         std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t)
     }
 
-    /// World-space axis-aligned bounds of the bricks of `volume` that this table makes
-    /// visible (None when nothing is visible): what a camera should frame.
-    pub fn visible_bounds(&self, volume: &Volume) -> Option<(glam::Vec3, glam::Vec3)> {
-        let bricks = volume.bricks();
-        let map = &volume.values;
-        let keep = bricks.occupancy(|lo, hi| self.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0);
-        let (lo, hi) = bricks.bounds_where(&keep)?;
-        Some(volume.grid.index_box_world_bounds(lo.max(glam::Vec3::splat(-0.5)), hi.min(volume.dims().as_vec3() - 0.5)))
-    }
-
     /// Largest opacity of any texel that a sample between the real values `lo..=hi` can
     /// touch (for empty-space skipping: zero means the range is invisible).
     pub fn max_opacity_between(&self, lo: f64, hi: f64) -> f32 {

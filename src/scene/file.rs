@@ -1,0 +1,327 @@
+//! The scene file format (RON). Unknown fields are errors, so a typo is reported with
+//! its line and column instead of being ignored.
+//!
+//! ```ron
+//! (
+//!     size: (512, 512),
+//!     background: (0.0, 0.0, 0.0),
+//!     datasets: [
+//!         (source: Phantom(kind: head, resolution: 256), appearance: (mode: dvr, preset: "ct_skin_bone")),
+//!         (source: File("../../shared/data/labels/aal.nii.gz"), appearance: (labels: Some((opacity: 0.3)))),
+//!     ],
+//!     camera: View(view: oblique),
+//!     frames: [
+//!         (name: "front", camera: Some(View(view: anterior))),
+//!         (name: "bone", set: [Preset(dataset: 0, preset: "ct_bone")]),
+//!     ],
+//! )
+//! ```
+//! Paths are relative to the scene file.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::region::{Light, Mode, Shading, View};
+use crate::transfer::TransferFunction;
+use crate::volume::phantom::Phantom;
+
+fn default_size() -> (u32, u32) {
+    (512, 512)
+}
+
+fn yes() -> bool {
+    true
+}
+
+fn default_step() -> f32 {
+    0.5
+}
+
+fn default_label_opacity() -> f32 {
+    0.6
+}
+
+fn default_resolution() -> u32 {
+    256
+}
+
+/// A whole scene: data, appearance, camera and the frames to capture.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Image size of headless renders (width, height).
+    #[serde(default = "default_size")]
+    pub size: (u32, u32),
+    /// Background colour (display sRGB).
+    #[serde(default)]
+    pub background: (f32, f32, f32),
+    #[serde(default)]
+    pub light: Light,
+    #[serde(default)]
+    pub rendering: RenderingSpec,
+    #[serde(default)]
+    pub datasets: Vec<DatasetSpec>,
+    #[serde(default)]
+    pub camera: CameraSpec,
+    /// Frames to capture; none means one frame of the scene as it is.
+    #[serde(default)]
+    pub frames: Vec<FrameSpec>,
+}
+
+/// Ray-caster switches.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderingSpec {
+    #[serde(default = "yes")]
+    pub jitter: bool,
+    #[serde(default = "yes")]
+    pub skip_empty: bool,
+    #[serde(default = "yes")]
+    pub early_termination: bool,
+}
+
+impl Default for RenderingSpec {
+    fn default() -> Self {
+        Self { jitter: true, skip_empty: true, early_termination: true }
+    }
+}
+
+/// Where a dataset's voxels come from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum SourceSpec {
+    /// A built-in phantom.
+    Phantom {
+        kind: Phantom,
+        #[serde(default = "default_resolution")]
+        resolution: u32,
+    },
+    /// The label volume of the head phantom.
+    PhantomLabels {
+        #[serde(default = "default_resolution")]
+        resolution: u32,
+    },
+    /// A volume file or DICOM folder.
+    File(PathBuf),
+    /// A headless raw file with its layout (`DIMS:TYPE[:le|be][:s=SPACING][:skip=N]`).
+    Raw { path: PathBuf, layout: String },
+}
+
+/// A dataset in the scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DatasetSpec {
+    #[serde(default)]
+    pub name: Option<String>,
+    pub source: SourceSpec,
+    #[serde(default)]
+    pub appearance: AppearanceSpec,
+    /// Placement: translation in millimetres and rotation (XYZ Euler angles, degrees).
+    #[serde(default)]
+    pub translation: (f32, f32, f32),
+    #[serde(default)]
+    pub rotation_deg: (f32, f32, f32),
+    #[serde(default = "yes")]
+    pub visible: bool,
+}
+
+/// How a dataset looks.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AppearanceSpec {
+    #[serde(default)]
+    pub mode: Mode,
+    /// A built-in preset name or a `.ron` file (default: chosen for the data).
+    #[serde(default)]
+    pub preset: Option<String>,
+    /// An inline transfer function (wins over `preset`).
+    #[serde(default)]
+    pub transfer: Option<TransferFunction>,
+    /// Show the dataset as a label volume.
+    #[serde(default)]
+    pub labels: Option<LabelsSpec>,
+    #[serde(default)]
+    pub shading: Option<Shading>,
+    /// Sample distance in units of the smallest voxel spacing.
+    #[serde(default = "default_step")]
+    pub step: f32,
+    /// Iso-value in the data's units (default: middle of the value range).
+    #[serde(default)]
+    pub iso: Option<f64>,
+}
+
+impl Default for AppearanceSpec {
+    fn default() -> Self {
+        Self { mode: Mode::Dvr, preset: None, transfer: None, labels: None, shading: None, step: 0.5, iso: None }
+    }
+}
+
+/// Label-volume display: the table and per-label overrides.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LabelsSpec {
+    /// Label table file (default: the sidecar files beside the volume).
+    #[serde(default)]
+    pub table: Option<PathBuf>,
+    /// Opacity of every label but the background.
+    #[serde(default = "default_label_opacity")]
+    pub opacity: f32,
+    /// Overrides by label id.
+    #[serde(default)]
+    pub styles: BTreeMap<u32, LabelOverride>,
+}
+
+impl Default for LabelsSpec {
+    fn default() -> Self {
+        Self { table: None, opacity: 0.6, styles: BTreeMap::new() }
+    }
+}
+
+/// A change to one label's style.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LabelOverride {
+    #[serde(default)]
+    pub color: Option<(f32, f32, f32)>,
+    #[serde(default)]
+    pub opacity: Option<f32>,
+    #[serde(default)]
+    pub visible: Option<bool>,
+}
+
+/// The camera.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum CameraSpec {
+    /// A standard view framing the visible data.
+    View {
+        view: View,
+        #[serde(default)]
+        orthographic: bool,
+        /// > 1 moves closer.
+        #[serde(default = "one")]
+        zoom: f32,
+    },
+    /// Azimuth and elevation around the visible data (see [`crate::region::Orbit`]).
+    Orbit {
+        azimuth_deg: f32,
+        elevation_deg: f32,
+        #[serde(default)]
+        orthographic: bool,
+        #[serde(default = "one")]
+        zoom: f32,
+    },
+    /// An explicit pose.
+    LookAt {
+        eye: (f32, f32, f32),
+        target: (f32, f32, f32),
+        #[serde(default = "z_up")]
+        up: (f32, f32, f32),
+        #[serde(default)]
+        orthographic_height: Option<f32>,
+        #[serde(default = "fov")]
+        fov_deg: f32,
+    },
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+fn z_up() -> (f32, f32, f32) {
+    (0.0, 0.0, 1.0)
+}
+
+fn fov() -> f32 {
+    30.0
+}
+
+impl Default for CameraSpec {
+    fn default() -> Self {
+        CameraSpec::View { view: View::Oblique, orthographic: false, zoom: 1.0 }
+    }
+}
+
+/// One captured frame: an optional camera and changes applied before it (they stay).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameSpec {
+    pub name: String,
+    #[serde(default)]
+    pub camera: Option<CameraSpec>,
+    #[serde(default)]
+    pub set: Vec<Change>,
+}
+
+/// A parameter change between frames. `dataset` is the index in `datasets`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Change {
+    Mode { dataset: usize, mode: Mode },
+    Preset { dataset: usize, preset: String },
+    Transfer { dataset: usize, transfer: TransferFunction },
+    Step { dataset: usize, step: f32 },
+    Iso { dataset: usize, value: f64 },
+    Shading { dataset: usize, enabled: bool },
+    Visible { dataset: usize, visible: bool },
+    LabelOpacity { dataset: usize, label: u32, opacity: f32 },
+    Background((f32, f32, f32)),
+    Light(Light),
+}
+
+impl SceneFile {
+    /// Parses RON text; `origin` names it in errors (with line and column).
+    pub fn parse(text: &str, origin: &str) -> Result<SceneFile, String> {
+        ron::from_str(text).map_err(|e| format!("{origin}: {e}"))
+    }
+
+    /// Writes RON text.
+    pub fn to_ron(&self) -> Result<String, String> {
+        ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default()).map_err(|e| e.to_string())
+    }
+
+    pub fn background(&self) -> [f32; 3] {
+        [self.background.0, self.background.1, self.background.2]
+    }
+}
+
+/// A tuple as a vector.
+pub fn vec3((x, y, z): (f32, f32, f32)) -> Vec3 {
+    Vec3::new(x, y, z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn minimal_and_full_scenes_parse() {
+        let s = SceneFile::parse("(datasets: [(source: Phantom(kind: head))])", "t.ron").unwrap();
+        assert_eq!(s.size, (512, 512));
+        assert_eq!(s.datasets[0].appearance.mode, Mode::Dvr);
+        assert_eq!(s.datasets[0].source, SourceSpec::Phantom { kind: Phantom::Head, resolution: 256 });
+        let full = r#"(
+            size: (64, 48),
+            datasets: [(source: File("a.nii.gz"), appearance: (mode: mip, preset: Some("grayscale_ramp"), labels: Some((opacity: 0.3, styles: {3: (visible: Some(false))}))))],
+            camera: Orbit(azimuth_deg: 30.0, elevation_deg: 10.0),
+            frames: [(name: "a", set: [Mode(dataset: 0, mode: xray), Background((1.0, 1.0, 1.0))])],
+        )"#;
+        let s = SceneFile::parse(full, "full.ron").unwrap();
+        assert_eq!(s.frames[0].set.len(), 2);
+        assert_eq!(s.datasets[0].appearance.labels.as_ref().unwrap().styles[&3].visible, Some(false));
+        // Round trip.
+        let again = SceneFile::parse(&s.to_ron().unwrap(), "again").unwrap();
+        assert_eq!(again, s);
+    }
+
+    #[test]
+    fn typos_are_errors_with_a_position() {
+        let e = SceneFile::parse("(datasets: [(source: Phantom(kind: head), apperance: (mode: mip))])", "typo.ron").unwrap_err();
+        assert!(e.starts_with("typo.ron") && e.contains("apperance") && e.contains("1:"), "{e}");
+        let e = SceneFile::parse("(datasets: [(source: Phantom(kind: brain))])", "kind.ron").unwrap_err();
+        assert!(e.contains("brain"), "{e}");
+    }
+}

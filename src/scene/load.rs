@@ -1,0 +1,270 @@
+//! From a scene file to volumes, appearances and cameras.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{Affine3A, EulerRot, Quat, Vec3};
+
+use super::file::{AppearanceSpec, CameraSpec, Change, DatasetSpec, LabelsSpec, SceneFile, SourceSpec, vec3};
+use crate::region::{Appearance, Camera, Lookup, Orbit, Projection, Region, RenderScene, View};
+use crate::transfer::{LabelTransfer, presets};
+use crate::volume::phantom::head;
+use crate::volume::readers::{RawSpec, ReadOptions, label_table, read_volume};
+use crate::volume::{LabelTable, LabelVolume, Volume};
+
+/// A dataset of a scene, loaded.
+#[derive(Clone, Debug)]
+pub struct LoadedDataset {
+    pub name: String,
+    pub volume: Arc<Volume>,
+    pub appearance: Appearance,
+    /// Labels table when shown as a label volume.
+    pub table: Option<LabelTable>,
+    pub transform: Affine3A,
+    pub visible: bool,
+    pub spec: DatasetSpec,
+}
+
+/// A path of the scene file resolved against the scene's folder.
+pub fn resolve(base: &Path, p: &Path) -> PathBuf {
+    if p.is_absolute() { p.to_path_buf() } else { base.join(p) }
+}
+
+/// Reads a scene file.
+pub fn read_scene(path: &Path) -> Result<SceneFile, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    SceneFile::parse(&text, &path.display().to_string())
+}
+
+/// Loads every dataset of `scene`; relative paths start at `base`.
+pub fn load_datasets(scene: &SceneFile, base: &Path) -> Result<Vec<LoadedDataset>, String> {
+    scene.datasets.iter().enumerate().map(|(i, d)| load_dataset(d, base).map_err(|e| format!("dataset {i}: {e}"))).collect()
+}
+
+fn load_dataset(spec: &DatasetSpec, base: &Path) -> Result<LoadedDataset, String> {
+    let (volume, sidecar_from) = match &spec.source {
+        SourceSpec::Phantom { kind, resolution } => (kind.generate(*resolution)?, None),
+        SourceSpec::PhantomLabels { resolution } => {
+            let h = head::generate(*resolution)?;
+            let table = h.labels.table.clone();
+            let app = appearance(&spec.appearance, &h.labels.volume, Some(&table), base)?;
+            return Ok(dataset(spec, h.labels.volume, app, Some(table)));
+        }
+        SourceSpec::File(p) => {
+            let p = resolve(base, p);
+            (read_volume(&p, &ReadOptions::default()).map_err(|e| e.to_string())?, Some(p))
+        }
+        SourceSpec::Raw { path, layout } => {
+            let raw: RawSpec = layout.parse()?;
+            let p = resolve(base, path);
+            (read_volume(&p, &ReadOptions { raw: Some(raw), ..Default::default() }).map_err(|e| e.to_string())?, Some(p))
+        }
+    };
+    match &spec.appearance.labels {
+        Some(labels) => {
+            let table = match (&labels.table, &sidecar_from) {
+                (Some(t), _) => label_table::read(&resolve(base, t)).map_err(|e| e.to_string())?,
+                (None, Some(p)) => label_table::read_sidecars(p).map_err(|e| e.to_string())?,
+                (None, None) => LabelTable::default(),
+            };
+            let lv = LabelVolume::from_volume(volume, table)?;
+            let app = appearance(&spec.appearance, &lv.volume, Some(&lv.table), base)?;
+            Ok(dataset(spec, lv.volume, app, Some(lv.table)))
+        }
+        None => {
+            let app = appearance(&spec.appearance, &volume, None, base)?;
+            Ok(dataset(spec, volume, app, None))
+        }
+    }
+}
+
+fn dataset(spec: &DatasetSpec, volume: Volume, appearance: Appearance, table: Option<LabelTable>) -> LoadedDataset {
+    let (rx, ry, rz) = spec.rotation_deg;
+    let rotation = Quat::from_euler(EulerRot::XYZ, rx.to_radians(), ry.to_radians(), rz.to_radians());
+    LoadedDataset {
+        name: spec.name.clone().unwrap_or_else(|| volume.name.clone()),
+        volume: Arc::new(volume),
+        appearance,
+        table,
+        transform: Affine3A::from_rotation_translation(rotation, vec3(spec.translation)),
+        visible: spec.visible,
+        spec: spec.clone(),
+    }
+}
+
+/// Label styles from the table, with the spec's opacity and overrides.
+pub fn label_styles(labels: &LabelsSpec, volume: &Volume, table: &LabelTable) -> LabelTransfer {
+    let ids = crate::volume::stats::code_counts(&volume.voxels).into_iter().enumerate().filter(|(_, c)| *c > 0).map(|(id, _)| id as u32);
+    let mut styles = LabelTransfer::from_table(table, ids, labels.opacity);
+    for (id, o) in &labels.styles {
+        let s = styles.styles.entry(*id).or_insert(crate::transfer::LabelStyle { color: [1.0; 3], opacity: labels.opacity, visible: true });
+        if let Some((r, g, b)) = o.color {
+            s.color = [r, g, b];
+        }
+        if let Some(a) = o.opacity {
+            s.opacity = a;
+        }
+        if let Some(v) = o.visible {
+            s.visible = v;
+        }
+    }
+    styles
+}
+
+/// The appearance a spec describes for `volume`.
+pub fn appearance(spec: &AppearanceSpec, volume: &Volume, table: Option<&LabelTable>, base: &Path) -> Result<Appearance, String> {
+    let lookup = match (&spec.labels, table) {
+        (Some(labels), Some(table)) => Lookup::Labels(label_styles(labels, volume, table)),
+        _ => Lookup::Transfer(match (&spec.transfer, &spec.preset) {
+            (Some(tf), _) => tf.clone().validated()?,
+            (None, Some(p)) => presets::load(&preset_path(p, base))?,
+            (None, None) if spec.mode.is_projection() => presets::builtin("grayscale_ramp")?,
+            (None, None) => presets::default_for(volume)?,
+        }),
+    };
+    if !(0.01..=16.0).contains(&spec.step) {
+        return Err(format!("step {} is outside 0.01..16 voxels", spec.step));
+    }
+    Ok(Appearance {
+        mode: spec.mode,
+        lookup,
+        shading: spec.shading.unwrap_or_default(),
+        step: spec.step,
+        iso_value: spec.iso.unwrap_or((volume.stats.min + volume.stats.max) * 0.5),
+    })
+}
+
+/// A preset key, or a `.ron` path resolved against the scene folder.
+fn preset_path(p: &str, base: &Path) -> String {
+    if p.ends_with(".ron") { resolve(base, Path::new(p)).display().to_string() } else { p.to_string() }
+}
+
+/// World bounds of what the visible datasets show (union; their boxes if nothing shows).
+pub fn visible_bounds(datasets: &[LoadedDataset]) -> (Vec3, Vec3) {
+    let mut out: Option<(Vec3, Vec3)> = None;
+    for d in datasets.iter().filter(|d| d.visible) {
+        let Some((lo, hi)) = d.appearance.visible_bounds(&d.volume).or_else(|| Some(d.volume.grid.world_bounds())) else { continue };
+        let corners = (0..8).map(|c| {
+            d.transform.transform_point3(Vec3::new(
+                if c & 1 == 0 { lo.x } else { hi.x },
+                if c & 2 == 0 { lo.y } else { hi.y },
+                if c & 4 == 0 { lo.z } else { hi.z },
+            ))
+        });
+        for c in corners {
+            out = Some(match out {
+                None => (c, c),
+                Some((a, b)) => (a.min(c), b.max(c)),
+            });
+        }
+    }
+    out.unwrap_or((Vec3::splat(-100.0), Vec3::splat(100.0)))
+}
+
+/// The camera a spec describes, framing `bounds` in a view of `aspect`.
+pub fn camera(spec: &CameraSpec, bounds: (Vec3, Vec3), aspect: f32) -> Camera {
+    let (lo, hi) = bounds;
+    let zoomed = |mut cam: Camera, zoom: f32| {
+        let target = (lo + hi) * 0.5;
+        let zoom = zoom.max(1e-3);
+        match &mut cam.projection {
+            Projection::Orthographic { height } => *height /= zoom,
+            Projection::Perspective { .. } => cam.position = target + (cam.position - target) / zoom,
+        }
+        cam
+    };
+    match *spec {
+        CameraSpec::View { view, orthographic, zoom } => zoomed(view.frame_box(lo, hi, aspect, orthographic), zoom),
+        CameraSpec::Orbit { azimuth_deg, elevation_deg, orthographic, zoom } => {
+            // Frame with the standard machinery, then turn to the requested angles.
+            let framed = View::Anterior.frame_box(lo, hi, aspect, orthographic);
+            let target = (lo + hi) * 0.5;
+            let distance = (framed.position - target).length().max((hi - lo).length());
+            let orbit = Orbit { target, azimuth_deg, elevation_deg, distance, projection: framed.projection };
+            zoomed(orbit.camera(), zoom)
+        }
+        CameraSpec::LookAt { eye, target, up, orthographic_height, fov_deg } => {
+            let projection = match orthographic_height {
+                Some(height) => Projection::Orthographic { height },
+                None => Projection::Perspective { fov_y: fov_deg.to_radians() },
+            };
+            Camera::look_at(vec3(eye), vec3(target), vec3(up), projection)
+        }
+    }
+}
+
+/// Applies a between-frames change to the datasets (and the scene settings).
+pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneFile, base: &Path) -> Result<(), String> {
+    let n = datasets.len();
+    let get = |i: usize| if i < n { Ok(i) } else { Err(format!("change refers to dataset {i}, the scene has {n}")) };
+    match change {
+        Change::Mode { dataset, mode } => datasets[get(*dataset)?].appearance.mode = *mode,
+        Change::Preset { dataset, preset } => {
+            datasets[get(*dataset)?].appearance.lookup = Lookup::Transfer(presets::load(&preset_path(preset, base))?)
+        }
+        Change::Transfer { dataset, transfer } => {
+            datasets[get(*dataset)?].appearance.lookup = Lookup::Transfer(transfer.clone().validated()?)
+        }
+        Change::Step { dataset, step } => datasets[get(*dataset)?].appearance.step = *step,
+        Change::Iso { dataset, value } => datasets[get(*dataset)?].appearance.iso_value = *value,
+        Change::Shading { dataset, enabled } => datasets[get(*dataset)?].appearance.shading.enabled = *enabled,
+        Change::Visible { dataset, visible } => datasets[get(*dataset)?].visible = *visible,
+        Change::LabelOpacity { dataset, label, opacity } => match &mut datasets[get(*dataset)?].appearance.lookup {
+            Lookup::Labels(styles) => {
+                if let Some(s) = styles.styles.get_mut(label) {
+                    s.opacity = *opacity;
+                }
+            }
+            Lookup::Transfer(_) => return Err(format!("dataset {dataset} is not shown as labels")),
+        },
+        Change::Background(c) => scene.background = *c,
+        Change::Light(l) => scene.light = *l,
+    }
+    Ok(())
+}
+
+/// The datasets as a scene the CPU reference renders (one region per visible dataset).
+pub fn render_scene(datasets: &[LoadedDataset], scene: &SceneFile) -> RenderScene {
+    let mut out = RenderScene {
+        background: scene.background(),
+        light: scene.light,
+        jitter: scene.rendering.jitter,
+        skip_empty: scene.rendering.skip_empty,
+        ..Default::default()
+    };
+    for d in datasets.iter().filter(|d| d.visible) {
+        let i = out.volumes.len();
+        out.regions.push(Region::volume_box_at(&d.volume.grid, d.transform, i, i));
+        out.volumes.push(d.volume.clone());
+        out.appearances.push(d.appearance.clone());
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn phantom_scene_loads_and_frames() {
+        let s = SceneFile::parse("(datasets: [(source: Phantom(kind: sphere, resolution: 24)), (source: PhantomLabels(resolution: 32), appearance: (labels: Some(())))])", "t").unwrap();
+        let d = load_datasets(&s, Path::new(".")).unwrap();
+        assert_eq!(d.len(), 2);
+        assert!(matches!(d[1].appearance.lookup, Lookup::Labels(_)));
+        let cam = camera(&s.camera, visible_bounds(&d), 1.0);
+        assert!(cam.position.length() > 10.0);
+        let mut s2 = s.clone();
+        let mut d2 = d.clone();
+        apply(&Change::Mode { dataset: 0, mode: crate::region::Mode::Mip }, &mut d2, &mut s2, Path::new(".")).unwrap();
+        assert_eq!(d2[0].appearance.mode, crate::region::Mode::Mip);
+        assert!(apply(&Change::Visible { dataset: 5, visible: false }, &mut d2, &mut s2, Path::new(".")).is_err());
+        assert_eq!(render_scene(&d2, &s2).regions.len(), 2);
+    }
+
+    #[test]
+    fn missing_files_name_the_dataset_and_the_file() {
+        let s = SceneFile::parse(r#"(datasets: [(source: File("nope.nii.gz"))])"#, "t").unwrap();
+        let e = load_datasets(&s, Path::new("/tmp")).unwrap_err();
+        assert!(e.contains("dataset 0") && e.contains("nope.nii.gz"), "{e}");
+    }
+}

@@ -1,0 +1,120 @@
+//! Rendering a scene file's frames headless, on the GPU (the default) or with the CPU
+//! reference, into PNG files `<scene>-<frame>.png`.
+
+use std::path::{Path, PathBuf};
+
+use bevy::prelude::*;
+
+use super::file::{FrameSpec, SceneFile};
+use super::load::{LoadedDataset, apply, camera, load_datasets, read_scene, render_scene, visible_bounds};
+use crate::FocalPlugins;
+use crate::dataset::{Dataset, SceneLight};
+use crate::reference::render;
+use crate::render::VolumeView;
+use crate::render::headless::Offscreen;
+
+/// How to render a scene file.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    pub out_dir: PathBuf,
+    /// Use the CPU reference renderer instead of the GPU.
+    pub cpu: bool,
+    /// Override the scene's image size.
+    pub size: Option<(u32, u32)>,
+}
+
+/// The frames to capture (one "default" frame when the file lists none).
+fn frames(scene: &SceneFile) -> Vec<FrameSpec> {
+    if scene.frames.is_empty() { vec![FrameSpec { name: "default".into(), camera: None, set: Vec::new() }] } else { scene.frames.clone() }
+}
+
+/// A file-name-safe version of a frame name.
+fn slug(name: &str) -> String {
+    name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
+}
+
+/// Renders every frame of the scene file at `path` into `options.out_dir`; returns the
+/// images written.
+pub fn render_scene_file(path: &Path, options: &RunOptions) -> Result<Vec<PathBuf>, String> {
+    let scene = read_scene(path)?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+    let images = render_frames(scene, &base, options).map_err(|e| format!("{}: {e}", path.display()))?;
+    std::fs::create_dir_all(&options.out_dir).map_err(|e| format!("{}: {e}", options.out_dir.display()))?;
+    let mut written = Vec::new();
+    for (name, image) in images {
+        let out = options.out_dir.join(format!("{}-{}.png", slug(&stem), slug(&name)));
+        image.save(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+        written.push(out);
+    }
+    Ok(written)
+}
+
+/// Renders every frame of `scene` (relative paths start at `base`): (frame name, image).
+pub fn render_frames(mut scene: SceneFile, base: &Path, options: &RunOptions) -> Result<Vec<(String, image::RgbaImage)>, String> {
+    let mut datasets = load_datasets(&scene, base)?;
+    let (w, h) = options.size.unwrap_or(scene.size);
+    // Frame on what the first frame shows; a frame that sets a camera frames anew what it
+    // shows, frames that only change parameters keep the framing.
+    let mut bounds = visible_bounds(&datasets);
+    let mut camera_spec = scene.camera.clone();
+    let mut gpu = if options.cpu { None } else { Some(GpuRun::new(w, h, &datasets)?) };
+    let mut images = Vec::new();
+    for frame in frames(&scene) {
+        for change in &frame.set {
+            apply(change, &mut datasets, &mut scene, base).map_err(|e| format!("frame '{}': {e}", frame.name))?;
+        }
+        if let Some(c) = &frame.camera {
+            camera_spec = c.clone();
+            bounds = visible_bounds(&datasets);
+        }
+        let cam = camera(&camera_spec, bounds, w as f32 / h as f32);
+        let image = match &mut gpu {
+            Some(g) => g.capture(&datasets, &scene, &cam)?,
+            None => render(&render_scene(&datasets, &scene), &cam, w, h)?.to_image()?,
+        };
+        images.push((frame.name.clone(), image));
+    }
+    Ok(images)
+}
+
+/// The offscreen app showing a scene's datasets.
+struct GpuRun {
+    off: Offscreen,
+    entities: Vec<Entity>,
+}
+
+impl GpuRun {
+    fn new(w: u32, h: u32, datasets: &[LoadedDataset]) -> Result<Self, String> {
+        let mut off = Offscreen::new(w, h, |app| {
+            app.add_plugins(FocalPlugins);
+        })?;
+        let entities = datasets.iter().map(|d| off.world_mut().spawn((dataset_component(d), transform(d))).id()).collect();
+        Ok(GpuRun { off, entities })
+    }
+
+    fn capture(&mut self, datasets: &[LoadedDataset], scene: &SceneFile, cam: &crate::region::Camera) -> Result<image::RgbaImage, String> {
+        for (e, d) in self.entities.iter().zip(datasets) {
+            self.off.world_mut().entity_mut(*e).insert((dataset_component(d), transform(d)));
+        }
+        self.off.world_mut().insert_resource(SceneLight(scene.light));
+        let r = scene.rendering;
+        self.off.set_view(VolumeView {
+            jitter: r.jitter,
+            skip_empty: r.skip_empty,
+            early_termination: r.early_termination,
+            ..Default::default()
+        });
+        self.off.set_background(scene.background());
+        self.off.set_camera(cam);
+        self.off.capture()
+    }
+}
+
+fn dataset_component(d: &LoadedDataset) -> Dataset {
+    Dataset { volume: d.volume.clone(), appearance: d.appearance.clone(), visible: d.visible }
+}
+
+fn transform(d: &LoadedDataset) -> Transform {
+    Transform::from_matrix(Mat4::from(d.transform))
+}
