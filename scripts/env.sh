@@ -5,9 +5,9 @@ set -euo pipefail
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/focal-target}"
 export CARGO_TERM_COLOR="${CARGO_TERM_COLOR:-never}"
 
-# Debian packages needed at run time: software Vulkan (lavapipe) for headless GPU
-# rendering where there is no GPU.
-FOCAL_PACKAGES=(mesa-vulkan-drivers)
+# Debian packages: software Vulkan (lavapipe) for GPU rendering where there is no GPU,
+# and a virtual X server for the app's window test.
+FOCAL_PACKAGES=(mesa-vulkan-drivers xvfb xauth)
 
 ensure_packages() {
   local missing=()
@@ -27,3 +27,8 @@ ensure_packages
 
 # wgpu: Vulkan (its GL backend panics on these machines).
 export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"
+# winit and Vulkan loaders want a private runtime directory.
+if [ -z "${XDG_RUNTIME_DIR:-}" ] || [ ! -d "${XDG_RUNTIME_DIR}" ]; then
+  export XDG_RUNTIME_DIR="${TMPDIR:-/tmp}/focal-runtime-$(id -u)"
+  mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
+fi

@@ -4,7 +4,8 @@
 //! [`volume`] holds the data model, readers and phantoms; [`transfer`] the transfer
 //! functions; [`region`] the geometry every renderer shares; [`reference`] the CPU
 //! reference renderer; [`dataset`] the dataset entities that become regions; [`render`]
-//! the GPU ray caster that packs and draws them; [`scene`] scene files.
+//! the GPU ray caster that packs and draws them; [`scene`] scene files; [`ui`] the
+//! desktop app.
 
 pub mod dataset;
 pub mod reference;
@@ -12,6 +13,7 @@ pub mod region;
 pub mod render;
 pub mod scene;
 pub mod transfer;
+pub mod ui;
 pub mod volume;
 
 use bevy::app::{PluginGroup, PluginGroupBuilder};

@@ -15,9 +15,21 @@ struct Args {
     command: Option<Command>,
     /// Volume file or DICOM folder to open (the built-in head phantom when omitted).
     volume: Option<PathBuf>,
-    /// Where the headless run writes its picture.
+    /// Where the run writes its picture when there is no display.
     #[arg(long, default_value = "out/focal.png")]
     out: PathBuf,
+    /// Render headless even when a display is available.
+    #[arg(long)]
+    headless: bool,
+    /// (Automation) In the app, save a screenshot to this path after --frames frames, then quit.
+    #[arg(long, requires = "frames")]
+    screenshot: Option<PathBuf>,
+    /// (Automation) Frames to draw before the screenshot.
+    #[arg(long)]
+    frames: Option<u32>,
+    /// Window size WIDTHxHEIGHT.
+    #[arg(long, default_value = "1440x900")]
+    window: String,
 }
 
 #[derive(Subcommand)]
@@ -28,12 +40,29 @@ enum Command {
     Render(cli::render::RenderArgs),
 }
 
+/// Whether a window can be opened (an X or Wayland display).
+fn has_display() -> bool {
+    ["DISPLAY", "WAYLAND_DISPLAY"].iter().any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
+}
+
 fn main() -> ExitCode {
     let args = Args::parse();
     let result = match args.command {
         Some(Command::Info(a)) => cli::info::run(&a),
         Some(Command::Render(a)) => cli::render::run(&a),
-        None => cli::render::run_headless(args.volume.as_deref(), &args.out),
+        None if args.headless || !has_display() => cli::render::run_headless(args.volume.as_deref(), &args.out),
+        None => {
+            let automation = args.screenshot.clone().zip(args.frames).map(|(p, n)| (n, p));
+            let window: Option<(u32, u32)> = args.window.split_once('x').and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
+            let Some(window) = window else {
+                eprintln!("error: window size '{}' is not WIDTHxHEIGHT", args.window);
+                return ExitCode::FAILURE;
+            };
+            match focal::ui::run(args.volume.clone(), automation, window) {
+                bevy::app::AppExit::Success => Ok(()),
+                bevy::app::AppExit::Error(code) => Err(format!("the app stopped with code {code}")),
+            }
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

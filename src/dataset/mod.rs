@@ -14,7 +14,7 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 use crate::region::{Appearance, Light, Region, RenderScene};
-use crate::volume::Volume;
+use crate::volume::{LabelTable, Volume};
 
 /// A volume in the scene.
 #[derive(Component, Clone)]
@@ -23,11 +23,13 @@ pub struct Dataset {
     pub appearance: Appearance,
     /// Whether this dataset is drawn.
     pub visible: bool,
+    /// Names and colours of the labels, for label volumes.
+    pub labels: Option<Arc<LabelTable>>,
 }
 
 impl Dataset {
     pub fn new(volume: Arc<Volume>, appearance: Appearance) -> Self {
-        Self { volume, appearance, visible: true }
+        Self { volume, appearance, visible: true, labels: None }
     }
 }
 

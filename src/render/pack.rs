@@ -121,6 +121,9 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.regions.push(region);
     }
     out.features = scene_features(&out.regions);
+    // Empty scenes still bind (1-texel) atlases.
+    out.atlas.size = out.atlas.size.max(UVec3::ONE);
+    out.brick_atlas.size = out.brick_atlas.size.max(UVec3::ONE);
     if out.lut.is_empty() {
         out.lut.push([0.0; 4]);
     }

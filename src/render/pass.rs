@@ -1,6 +1,7 @@
 //! The ray-cast pass: a system in the `Core3d` schedule, one full-screen triangle per view.
 
 use bevy::prelude::*;
+use bevy::render::camera::ExtractedCamera;
 use bevy::render::extract_component::{ComponentUniforms, DynamicUniformIndex};
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, ViewQuery};
@@ -12,7 +13,14 @@ use super::upload::GpuScene;
 
 #[allow(clippy::too_many_arguments)]
 pub fn raycast_pass(
-    view: ViewQuery<(&ViewTarget, &ViewDepthTexture, &ViewUniformOffset, &DynamicUniformIndex<GpuSettings>, &RaycastPipelineId)>,
+    view: ViewQuery<(
+        &ViewTarget,
+        &ViewDepthTexture,
+        &ViewUniformOffset,
+        &DynamicUniformIndex<GpuSettings>,
+        &RaycastPipelineId,
+        Option<&ExtractedCamera>,
+    )>,
     pipeline: Res<RaycastPipeline>,
     cache: Res<PipelineCache>,
     view_uniforms: Res<ViewUniforms>,
@@ -20,7 +28,7 @@ pub fn raycast_pass(
     scene: Res<GpuScene>,
     mut ctx: RenderContext,
 ) {
-    let (target, depth, view_offset, settings_index, pipeline_id) = view.into_inner();
+    let (target, depth, view_offset, settings_index, pipeline_id, camera) = view.into_inner();
     if scene.region_count == 0 || !scene.ready() {
         return;
     }
@@ -64,6 +72,12 @@ pub fn raycast_pass(
         occlusion_query_set: None,
         multiview_mask: None,
     });
+    // A camera limited to part of its target (the app's viewport beside the panels):
+    // the full-screen triangle then spans just that part.
+    if let Some(v) = camera.and_then(|c| c.viewport.as_ref()) {
+        let (p, s) = (v.physical_position.as_vec2(), v.physical_size.as_vec2());
+        pass.set_viewport(p.x, p.y, s.x, s.y, v.depth.start, v.depth.end);
+    }
     pass.set_pipeline(render_pipeline);
     pass.set_bind_group(0, &bind_group, &[view_offset.offset, settings_index.index()]);
     pass.draw(0..3, 0..1);

@@ -9,7 +9,7 @@ use super::file::{AppearanceSpec, CameraSpec, Change, DatasetSpec, LabelsSpec, S
 use crate::region::{Appearance, Camera, Lookup, Orbit, Projection, Region, RenderScene, View};
 use crate::transfer::{LabelTransfer, presets};
 use crate::volume::phantom::head;
-use crate::volume::readers::{RawSpec, ReadOptions, label_table, read_volume};
+use crate::volume::readers::{Progress, RawSpec, ReadOptions, label_table, read_volume};
 use crate::volume::{LabelTable, LabelVolume, Volume};
 
 /// A dataset of a scene, loaded.
@@ -38,10 +38,16 @@ pub fn read_scene(path: &Path) -> Result<SceneFile, String> {
 
 /// Loads every dataset of `scene`; relative paths start at `base`.
 pub fn load_datasets(scene: &SceneFile, base: &Path) -> Result<Vec<LoadedDataset>, String> {
-    scene.datasets.iter().enumerate().map(|(i, d)| load_dataset(d, base).map_err(|e| format!("dataset {i}: {e}"))).collect()
+    load_datasets_with(scene, base, None)
 }
 
-fn load_dataset(spec: &DatasetSpec, base: &Path) -> Result<LoadedDataset, String> {
+/// Like [`load_datasets`], reporting the bytes read to `progress`.
+pub fn load_datasets_with(scene: &SceneFile, base: &Path, progress: Option<Progress>) -> Result<Vec<LoadedDataset>, String> {
+    let options = ReadOptions { progress, ..Default::default() };
+    scene.datasets.iter().enumerate().map(|(i, d)| load_dataset(d, base, &options).map_err(|e| format!("dataset {i}: {e}"))).collect()
+}
+
+fn load_dataset(spec: &DatasetSpec, base: &Path, options: &ReadOptions) -> Result<LoadedDataset, String> {
     let (volume, sidecar_from) = match &spec.source {
         SourceSpec::Phantom { kind, resolution } => (kind.generate(*resolution)?, None),
         SourceSpec::PhantomLabels { resolution } => {
@@ -52,12 +58,12 @@ fn load_dataset(spec: &DatasetSpec, base: &Path) -> Result<LoadedDataset, String
         }
         SourceSpec::File(p) => {
             let p = resolve(base, p);
-            (read_volume(&p, &ReadOptions::default()).map_err(|e| e.to_string())?, Some(p))
+            (read_volume(&p, options).map_err(|e| e.to_string())?, Some(p))
         }
         SourceSpec::Raw { path, layout } => {
             let raw: RawSpec = layout.parse()?;
             let p = resolve(base, path);
-            (read_volume(&p, &ReadOptions { raw: Some(raw), ..Default::default() }).map_err(|e| e.to_string())?, Some(p))
+            (read_volume(&p, &ReadOptions { raw: Some(raw), ..options.clone() }).map_err(|e| e.to_string())?, Some(p))
         }
     };
     match &spec.appearance.labels {

@@ -6,6 +6,7 @@
 pub mod file;
 pub mod load;
 pub mod run;
+pub mod save;
 
 pub use file::SceneFile;
 pub use load::{LoadedDataset, load_datasets, read_scene};

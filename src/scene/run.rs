@@ -3,6 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
+use std::sync::Arc;
+
 use bevy::prelude::*;
 
 use super::file::{FrameSpec, SceneFile};
@@ -112,7 +114,7 @@ impl GpuRun {
 }
 
 fn dataset_component(d: &LoadedDataset) -> Dataset {
-    Dataset { volume: d.volume.clone(), appearance: d.appearance.clone(), visible: d.visible }
+    Dataset { volume: d.volume.clone(), appearance: d.appearance.clone(), visible: d.visible, labels: d.table.clone().map(Arc::new) }
 }
 
 fn transform(d: &LoadedDataset) -> Transform {

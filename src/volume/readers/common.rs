@@ -3,6 +3,8 @@
 use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use flate2::read::{GzDecoder, ZlibDecoder};
 use glam::UVec3;
@@ -47,6 +49,45 @@ pub enum Problem {
     Values(String),
 }
 
+/// Bytes read so far out of the bytes to read, shared with whoever shows a progress bar.
+#[derive(Clone, Debug, Default)]
+pub struct Progress {
+    done: Arc<AtomicU64>,
+    total: Arc<AtomicU64>,
+}
+
+impl Progress {
+    /// Fraction done, once anything is known about the total.
+    pub fn fraction(&self) -> Option<f32> {
+        let total = self.total.load(Ordering::Relaxed);
+        (total > 0).then(|| (self.done.load(Ordering::Relaxed) as f64 / total as f64).min(1.0) as f32)
+    }
+
+    pub fn add_total(&self, bytes: u64) {
+        self.total.fetch_add(bytes, Ordering::Relaxed);
+    }
+
+    pub fn add_done(&self, bytes: u64) {
+        self.done.fetch_add(bytes, Ordering::Relaxed);
+    }
+}
+
+/// A reader that counts what passes through it.
+pub struct Counting<R> {
+    inner: R,
+    progress: Option<Progress>,
+}
+
+impl<R: Read> Read for Counting<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        if let Some(p) = &self.progress {
+            p.add_done(n as u64);
+        }
+        Ok(n)
+    }
+}
+
 /// How to read, and what to refuse.
 #[derive(Clone, Debug)]
 pub struct ReadOptions {
@@ -56,11 +97,23 @@ pub struct ReadOptions {
     pub max_bytes: u64,
     /// Dimensions and type for headerless raw files.
     pub raw: Option<RawSpec>,
+    /// Where to report progress.
+    pub progress: Option<Progress>,
 }
 
 impl Default for ReadOptions {
     fn default() -> Self {
-        Self { max_voxels: 1 << 31, max_bytes: 8 << 30, raw: None }
+        Self { max_voxels: 1 << 31, max_bytes: 8 << 30, raw: None, progress: None }
+    }
+}
+
+impl ReadOptions {
+    /// Reports a whole file read at once (`size` bytes).
+    pub fn count_whole(&self, size: u64) {
+        if let Some(p) = &self.progress {
+            p.add_total(size);
+            p.add_done(size);
+        }
     }
 }
 
@@ -154,9 +207,13 @@ pub fn inflate_zlib(block: &[u8], len: usize) -> Result<Vec<u8>, Problem> {
 /// Buffer size of file readers: large reads keep system calls few.
 pub const READ_BUFFER: usize = 1 << 20;
 
-/// Opens a file for buffered reading.
-pub fn open_buffered(path: &Path) -> Result<std::io::BufReader<File>, ReadError> {
-    Ok(std::io::BufReader::with_capacity(READ_BUFFER, open(path)?))
+/// Opens a file for buffered reading, counting its bytes into the options' progress.
+pub fn open_buffered(path: &Path, options: &ReadOptions) -> Result<std::io::BufReader<Counting<File>>, ReadError> {
+    let file = open(path)?;
+    if let Some(p) = &options.progress {
+        p.add_total(file.metadata().map(|m| m.len()).unwrap_or(0));
+    }
+    Ok(std::io::BufReader::with_capacity(READ_BUFFER, Counting { inner: file, progress: options.progress.clone() }))
 }
 
 /// Opens a file, mapping failure to a [`ReadError`].

@@ -95,7 +95,7 @@ fn sample_type(name: &str) -> Result<SampleType, Problem> {
 /// Reads a MetaImage file.
 pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
     let fail = |p: Problem| ReadError::new(path, p);
-    let mut reader = open_buffered(path)?;
+    let mut reader = open_buffered(path, options)?;
     let h = parse_header(&mut reader).map_err(fail)?;
     if let Some(t) = h.get("ObjectType")
         && !t.eq_ignore_ascii_case("Image")
@@ -169,7 +169,7 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
         let chunk = match f {
             None => read_stream(path, &mut reader, compressed, binary, header_size, want, ty)?,
             Some(p) => {
-                let mut r = open_buffered(p)?;
+                let mut r = open_buffered(p, options)?;
                 let skip_bytes =
                     if header_size == -1 && !compressed { file_len(p)?.saturating_sub(want as u64) as i64 } else { header_size };
                 read_stream(p, &mut r, compressed, binary, skip_bytes, want, ty)?

@@ -21,7 +21,7 @@ use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
-pub use common::{Problem, ReadError, ReadOptions};
+pub use common::{Problem, Progress, ReadError, ReadOptions};
 pub use raw::RawSpec;
 
 use super::{LabelVolume, Volume};

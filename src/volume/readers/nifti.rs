@@ -51,7 +51,8 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
     let fail = |p: Problem| ReadError::new(path, p);
     let gz = path.to_string_lossy().to_ascii_lowercase().ends_with(".gz");
     let header_path = header_path(path);
-    let mut stream = decoder(open_buffered(&header_path)?, if is_gz(&header_path) { Compression::Gzip } else { Compression::None });
+    let mut stream =
+        decoder(open_buffered(&header_path, options)?, if is_gz(&header_path) { Compression::Gzip } else { Compression::None });
     // sizeof_hdr (348 or 540, either byte order) says how much header to read.
     let mut head = Vec::with_capacity(540);
     (&mut stream).take(4).read_to_end(&mut head).map_err(|e| fail(Problem::Io(e)))?;
@@ -79,7 +80,7 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
         if c == Compression::None {
             check_file_len(&img, len as u64)?;
         }
-        read_exact_bounded(decoder(open_buffered(&img)?, c), len).map_err(|p| ReadError::new(&img, p))?
+        read_exact_bounded(decoder(open_buffered(&img, options)?, c), len).map_err(|p| ReadError::new(&img, p))?
     } else {
         let offset = header.vox_offset;
         if !offset.is_finite() || offset < head.len() as f64 || offset > 1e9 {

@@ -134,7 +134,7 @@ fn parse_vectors(field: &str, text: &str) -> Result<Vec<Option<Vec3>>, Problem> 
 /// Reads a NRRD file.
 pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
     let fail = |p: Problem| ReadError::new(path, p);
-    let mut reader = open_buffered(path)?;
+    let mut reader = open_buffered(path, options)?;
     let header = parse_header(&mut reader).map_err(fail)?;
 
     let ty = sample_type(header.require("type").map_err(fail)?).map_err(fail)?;
@@ -197,7 +197,7 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
             let mut data = Vec::new();
             for (i, file) in files.iter().enumerate() {
                 let want = if i + 1 == files.len() { len - per_file * i } else { per_file };
-                let chunk = read_chunk(path, file.as_deref(), &mut reader, compression, line_skip, byte_skip, want)?;
+                let chunk = read_chunk(path, file.as_deref(), &mut reader, compression, line_skip, byte_skip, want, options)?;
                 if data.is_empty() { data = chunk } else { data.extend_from_slice(&chunk) }
             }
             encode(data, ty, order).map_err(fail)?
@@ -301,13 +301,14 @@ fn read_chunk(
     line_skip: u64,
     byte_skip: i64,
     len: usize,
+    options: &ReadOptions,
 ) -> Result<Vec<u8>, ReadError> {
     let at = file.unwrap_or(header_path);
     let fail = |p: Problem| ReadError::new(at, p);
     let mut own;
     let stream: &mut dyn Read = match file {
         Some(f) => {
-            own = open_buffered(f)?;
+            own = open_buffered(f, options)?;
             &mut own
         }
         None => attached,
@@ -334,7 +335,7 @@ fn read_chunk(
         if total < len as u64 {
             return Err(fail(Problem::Truncated(format!("file has {total} bytes, {len} needed"))));
         }
-        let mut data = open_buffered(f)?;
+        let mut data = open_buffered(f, options)?;
         skip(&mut data, total - len as u64).map_err(fail)?;
         return read_exact_bounded(data, len).map_err(fail);
     }

@@ -107,7 +107,7 @@ pub fn read_as(
     } else if skip_bytes < 0 {
         return Err(fail(Problem::Malformed("skip -1 needs an uncompressed file".into())));
     }
-    let mut stream = decoder(open_buffered(path)?, if gz { Compression::Gzip } else { Compression::None });
+    let mut stream = decoder(open_buffered(path, options)?, if gz { Compression::Gzip } else { Compression::None });
     skip(&mut stream, skip_bytes as u64).map_err(fail)?;
     let bytes = read_exact_bounded(stream, len).map_err(fail)?;
     let encoded = encode(bytes, spec.sample, spec.order).map_err(fail)?;

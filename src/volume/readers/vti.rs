@@ -201,6 +201,7 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
         return Err(fail(Problem::TooLarge(format!("a {size}-byte file"))));
     }
     let bytes = std::fs::read(path).map_err(|e| fail(Problem::Io(e)))?;
+    options.count_whole(size);
     // The XML part ends where raw appended data begins.
     let appended_at = find(&bytes, b"<AppendedData");
     let xml_end = appended_at.map(|a| find(&bytes[a..], b">").map(|e| a + e + 1).unwrap_or(bytes.len())).unwrap_or(bytes.len());

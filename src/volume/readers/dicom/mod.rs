@@ -81,6 +81,7 @@ pub fn open(path: &Path, options: &ReadOptions) -> Result<DefaultDicomObject, Re
         return Err(fail(Problem::TooLarge(format!("a {len}-byte DICOM file"))));
     }
     let bytes = std::fs::read(path).map_err(|e| fail(Problem::Io(e)))?;
+    options.count_whole(len);
     guard::check(&bytes).map_err(fail)?;
     let (start, _) = guard::meta_start(&bytes).map_err(fail)?;
     let from = &bytes[start - 4..];

@@ -1,0 +1,150 @@
+//! Loading files and scenes in the background.
+//!
+//! A load runs on the async compute pool and reports bytes read through a
+//! [`Progress`]; the app shows a progress bar meanwhile. When it succeeds the current
+//! datasets are replaced; when it fails the error is kept for the app to show and the
+//! current data stays. Works without a window (see `tests/app.rs`).
+
+use std::path::{Path, PathBuf};
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
+
+use crate::dataset::{Dataset, SceneLight};
+use crate::scene::file::{AppearanceSpec, DatasetSpec, SceneFile, SourceSpec};
+use crate::scene::load::{LoadedDataset, load_datasets_with, read_scene, visible_bounds};
+use crate::volume::readers::Progress;
+
+/// What the app is showing: where it came from and what went wrong last.
+#[derive(Resource, Default)]
+pub struct Session {
+    /// The scene as loaded (datasets' origins, camera), for saving.
+    pub scene: Option<SceneFile>,
+    /// Folder relative paths of the scene are resolved against.
+    pub base: PathBuf,
+    /// The last load error, shown until dismissed.
+    pub error: Option<String>,
+    /// Set when new data arrived: the camera should frame it.
+    pub reframe: Option<(Vec3, Vec3)>,
+}
+
+/// A load under way.
+#[derive(Component)]
+pub struct Loading {
+    pub what: String,
+    pub progress: Progress,
+    task: Task<Result<(SceneFile, PathBuf, Vec<LoadedDataset>), String>>,
+}
+
+/// A dataset entity made from a scene file: remembers its spec for saving.
+#[derive(Component, Clone)]
+pub struct DatasetOrigin(pub DatasetSpec);
+
+/// Ask the app to load a file, a DICOM folder, a scene file, or the default scene.
+#[derive(Message, Clone, Debug)]
+pub enum LoadRequest {
+    Path(PathBuf),
+    Scene(SceneFile, PathBuf),
+}
+
+/// A scene showing one data file with its default look (labels shown as labels when a
+/// label table lies beside it).
+pub fn scene_for_file(path: &Path) -> SceneFile {
+    let labels = crate::volume::readers::label_table::read_sidecars(path).map(|t| !t.is_empty()).unwrap_or(false);
+    let mut scene = SceneFile::parse("()", "empty").unwrap_or_else(|_| unreachable!("an empty scene parses"));
+    scene.datasets.push(DatasetSpec {
+        name: None,
+        source: SourceSpec::File(path.to_path_buf()),
+        appearance: AppearanceSpec { labels: labels.then(Default::default), ..Default::default() },
+        translation: (0.0, 0.0, 0.0),
+        rotation_deg: (0.0, 0.0, 0.0),
+        visible: true,
+    });
+    scene
+}
+
+/// Starts loads on the compute pool.
+pub fn start_loads(mut commands: Commands, mut requests: MessageReader<LoadRequest>) {
+    for request in requests.read() {
+        let progress = Progress::default();
+        let p = progress.clone();
+        let (what, job): (String, Box<dyn FnOnce() -> Result<(SceneFile, PathBuf, Vec<LoadedDataset>), String> + Send>) =
+            match request.clone() {
+                LoadRequest::Path(path) => (
+                    path.display().to_string(),
+                    Box::new(move || {
+                        let (scene, base) = if path.extension().is_some_and(|e| e == "ron") {
+                            (read_scene(&path)?, path.parent().map(Path::to_path_buf).unwrap_or_default())
+                        } else {
+                            (scene_for_file(&path), PathBuf::new())
+                        };
+                        let datasets = load_datasets_with(&scene, &base, Some(p))?;
+                        Ok((scene, base, datasets))
+                    }),
+                ),
+                LoadRequest::Scene(scene, base) => (
+                    "scene".to_string(),
+                    Box::new(move || {
+                        let datasets = load_datasets_with(&scene, &base, Some(p))?;
+                        Ok((scene, base, datasets))
+                    }),
+                ),
+            };
+        let task = AsyncComputeTaskPool::get().spawn(async move { job() });
+        commands.spawn(Loading { what, progress, task });
+    }
+}
+
+/// Replaces the datasets when a load finishes, or records its error.
+pub fn finish_loads(
+    mut commands: Commands,
+    mut loads: Query<(Entity, &mut Loading)>,
+    old: Query<Entity, With<Dataset>>,
+    mut session: ResMut<Session>,
+    mut light: ResMut<SceneLight>,
+) {
+    for (entity, mut load) in &mut loads {
+        let Some(result) = check_ready(&mut load.task) else { continue };
+        commands.entity(entity).despawn();
+        match result {
+            Ok((scene, base, datasets)) => {
+                for e in &old {
+                    commands.entity(e).despawn();
+                }
+                for d in &datasets {
+                    commands.spawn((
+                        Dataset {
+                            volume: d.volume.clone(),
+                            appearance: d.appearance.clone(),
+                            visible: d.visible,
+                            labels: d.table.clone().map(Arc::new),
+                        },
+                        Transform::from_matrix(Mat4::from(d.transform)),
+                        DatasetOrigin(d.spec.clone()),
+                        Name::new(d.name.clone()),
+                    ));
+                }
+                light.0 = scene.light;
+                session.reframe = Some(visible_bounds(&datasets));
+                session.scene = Some(scene);
+                session.base = base;
+                session.error = None;
+            }
+            Err(e) => {
+                error!("{}: {e}", load.what);
+                session.error = Some(format!("Could not open {}: {e}", load.what));
+            }
+        }
+    }
+}
+
+/// Loading without a window: the messages and the systems.
+pub struct LoadingPlugin;
+
+impl Plugin for LoadingPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<Session>().add_message::<LoadRequest>().add_systems(Update, (start_loads, finish_loads).chain());
+    }
+}

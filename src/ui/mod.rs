@@ -1,0 +1,371 @@
+//! The desktop app: egui panels, the orbit camera, loading, shortcuts.
+//!
+//! `focal [FILE]` opens a window on the built-in head phantom (or the file, DICOM folder
+//! or scene given). Files open from the Open dialogs, by drag and drop, or on the
+//! command line; loading runs in the background with a progress bar and a failed load
+//! leaves the current data in place. See [`SHORTCUTS`] for the keys.
+
+pub mod loading;
+pub mod orbit;
+pub mod panels;
+pub mod tf_editor;
+
+use std::path::PathBuf;
+
+use bevy::camera::visibility::RenderLayers;
+use bevy::camera::{CameraOutputMode, Viewport};
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::diagnostic::FrameTimeDiagnosticsPlugin;
+use bevy::prelude::*;
+use bevy::render::render_resource::BlendState;
+use bevy::render::view::screenshot::{Screenshot, save_to_disk};
+use bevy::window::PrimaryWindow;
+use bevy_egui::{EguiGlobalSettings, EguiPlugin, EguiPrimaryContextPass, PrimaryEguiContext};
+
+use crate::dataset::SceneRegions;
+use crate::region::View;
+use crate::render::VolumeView;
+use loading::{LoadRequest, LoadingPlugin, Session};
+use orbit::{OrbitCamera, PointerInViewport};
+
+/// Keyboard shortcuts, as listed in the help panel.
+pub const SHORTCUTS: &[(&str, &str)] = &[
+    ("Left drag", "orbit"),
+    ("Right / middle drag", "pan"),
+    ("Wheel", "zoom"),
+    ("Double-click", "centre on the point under the cursor"),
+    ("R", "reset the camera"),
+    ("1 … 6", "view from front, back, left, right, top, bottom"),
+    ("7", "oblique view"),
+    ("P", "perspective / orthographic"),
+    ("M", "next rendering mode"),
+    ("Ctrl+O", "open a file"),
+    ("Ctrl+S", "save the scene"),
+    ("F12 or S", "save a screenshot (out/)"),
+    ("F", "show the frame rate"),
+    ("H or F1", "this help"),
+];
+
+/// The app's own settings and panel state.
+#[derive(Resource)]
+pub struct AppState {
+    pub show_help: bool,
+    pub show_fps: bool,
+    pub background: [f32; 3],
+    pub view: VolumeView,
+    /// The dataset the panels edit (index among the datasets).
+    pub selected: usize,
+    pub editor: tf_editor::EditorState,
+    pub dialog: egui_file_dialog::FileDialog,
+    pub dialog_purpose: DialogPurpose,
+    /// Last screenshot written, to report it.
+    pub last_screenshot: Option<PathBuf>,
+    /// Automation: write a screenshot after this many frames, then quit.
+    pub screenshot_and_exit: Option<(u32, PathBuf)>,
+    pub frames: u32,
+}
+
+/// What the open file dialog is for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DialogPurpose {
+    #[default]
+    Open,
+    SaveScene,
+}
+
+impl Default for AppState {
+    fn default() -> Self {
+        Self {
+            show_help: false,
+            show_fps: false,
+            background: [0.0; 3],
+            view: VolumeView::default(),
+            selected: 0,
+            editor: Default::default(),
+            dialog: egui_file_dialog::FileDialog::new(),
+            dialog_purpose: DialogPurpose::Open,
+            last_screenshot: None,
+            screenshot_and_exit: None,
+            frames: 0,
+        }
+    }
+}
+
+/// Marks the 3D camera of the app.
+#[derive(Component)]
+pub struct MainCamera;
+
+/// The app: panels, camera control, loading.
+pub struct FocalAppPlugin {
+    /// File, folder or scene to open at start (the default scene when `None`).
+    pub initial: Option<PathBuf>,
+    /// Automation for tests: screenshot after N frames to a path, then exit.
+    pub screenshot_and_exit: Option<(u32, PathBuf)>,
+}
+
+impl Plugin for FocalAppPlugin {
+    fn build(&self, app: &mut App) {
+        let initial = self.initial.clone();
+        app.add_plugins((EguiPlugin::default(), FrameTimeDiagnosticsPlugin::default(), LoadingPlugin))
+            .insert_resource(AppState { screenshot_and_exit: self.screenshot_and_exit.clone(), ..Default::default() })
+            .init_resource::<PointerInViewport>()
+            .add_systems(
+                Startup,
+                move |mut commands: Commands, mut egui: ResMut<EguiGlobalSettings>, mut load: MessageWriter<LoadRequest>| {
+                    setup(&mut commands, &mut egui);
+                    load.write(match &initial {
+                        Some(p) => LoadRequest::Path(p.clone()),
+                        None => LoadRequest::Scene(default_scene(), PathBuf::new()),
+                    });
+                },
+            )
+            .add_systems(
+                Update,
+                (orbit::orbit_input, shortcuts, dropped_files, centre_on_double_click, reframe, sync_view, automation, orbit::apply_orbit)
+                    .chain(),
+            )
+            .add_systems(EguiPrimaryContextPass, panels::ui);
+    }
+}
+
+/// The default scene (the head phantom), embedded.
+pub fn default_scene() -> crate::scene::SceneFile {
+    const TEXT: &str = include_str!("../../assets/scenes/default.ron");
+    crate::scene::SceneFile::parse(TEXT, "assets/scenes/default.ron")
+        .unwrap_or_else(|e| unreachable!("the embedded default scene parses: {e}"))
+}
+
+fn setup(commands: &mut Commands, egui: &mut EguiGlobalSettings) {
+    // The 3D view and a separate camera for the panels, so the view can be limited to
+    // the free part of the window.
+    egui.auto_create_primary_context = false;
+    let orbit = OrbitCamera::default();
+    let (transform, projection) = orbit.bevy();
+    commands.spawn((
+        MainCamera,
+        Camera3d::default(),
+        Msaa::Off,
+        Tonemapping::None,
+        Camera { clear_color: Color::BLACK.into(), ..default() },
+        transform,
+        projection,
+        orbit,
+        VolumeView::default(),
+    ));
+    commands.spawn((
+        PrimaryEguiContext,
+        Camera2d,
+        RenderLayers::none(),
+        Camera {
+            order: 1,
+            output_mode: CameraOutputMode::Write { blend_state: Some(BlendState::ALPHA_BLENDING), clear_color: ClearColorConfig::None },
+            clear_color: ClearColorConfig::None,
+            ..default()
+        },
+    ));
+    commands.spawn((DirectionalLight::default(), Transform::from_xyz(1.0, -2.0, 3.0).looking_at(Vec3::ZERO, Vec3::Z)));
+}
+
+/// Opens dropped files and folders.
+fn dropped_files(mut drops: MessageReader<FileDragAndDrop>, mut load: MessageWriter<LoadRequest>) {
+    for d in drops.read() {
+        if let FileDragAndDrop::DroppedFile { path_buf, .. } = d {
+            load.write(LoadRequest::Path(path_buf.clone()));
+        }
+    }
+}
+
+/// Keyboard shortcuts (ignored while egui has the keyboard).
+fn shortcuts(
+    keys: Res<ButtonInput<KeyCode>>,
+    mut state: ResMut<AppState>,
+    mut contexts: bevy_egui::EguiContexts,
+    mut cams: Query<&mut OrbitCamera>,
+    regions: Res<SceneRegions>,
+    mut commands: Commands,
+    mut datasets: Query<&mut crate::dataset::Dataset>,
+) {
+    if contexts.ctx_mut().is_ok_and(|c| c.egui_wants_keyboard_input()) {
+        return;
+    }
+    let ctrl = keys.any_pressed([KeyCode::ControlLeft, KeyCode::ControlRight]);
+    if keys.just_pressed(KeyCode::KeyH) || keys.just_pressed(KeyCode::F1) {
+        state.show_help = !state.show_help;
+    }
+    if keys.just_pressed(KeyCode::KeyF) {
+        state.show_fps = !state.show_fps;
+    }
+    if keys.just_pressed(KeyCode::F12) || (keys.just_pressed(KeyCode::KeyS) && !ctrl) {
+        let path = screenshot_path();
+        commands.spawn(Screenshot::primary_window()).observe(save_to_disk(path.clone()));
+        state.last_screenshot = Some(path);
+    }
+    if ctrl && keys.just_pressed(KeyCode::KeyO) {
+        state.dialog_purpose = DialogPurpose::Open;
+        state.dialog.pick_file();
+    }
+    if ctrl && keys.just_pressed(KeyCode::KeyS) {
+        state.dialog_purpose = DialogPurpose::SaveScene;
+        state.dialog.save_file();
+    }
+    if keys.just_pressed(KeyCode::KeyM) {
+        let selected = state.selected;
+        if let Some(mut d) = datasets.iter_mut().nth(selected) {
+            let modes = crate::region::Mode::ALL;
+            let i = modes.iter().position(|m| *m == d.appearance.mode).unwrap_or(0);
+            d.appearance.mode = modes[(i + 1) % modes.len()];
+        }
+    }
+    let Ok(mut orbit) = cams.single_mut() else { return };
+    let views = [
+        (KeyCode::Digit1, View::Anterior),
+        (KeyCode::Digit2, View::Posterior),
+        (KeyCode::Digit3, View::Left),
+        (KeyCode::Digit4, View::Right),
+        (KeyCode::Digit5, View::Superior),
+        (KeyCode::Digit6, View::Inferior),
+        (KeyCode::Digit7, View::Oblique),
+    ];
+    let bounds = scene_bounds(&regions);
+    for (key, view) in views {
+        if keys.just_pressed(key) {
+            orbit.frame(view, bounds.0, bounds.1, 1.0);
+        }
+    }
+    if keys.just_pressed(KeyCode::KeyR) {
+        orbit.frame(View::Oblique, bounds.0, bounds.1, 1.0);
+    }
+    if keys.just_pressed(KeyCode::KeyP) {
+        orbit.orthographic = !orbit.orthographic;
+    }
+}
+
+/// Where screenshots go.
+fn screenshot_path() -> PathBuf {
+    let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
+    let dir = PathBuf::from("out");
+    let _ = std::fs::create_dir_all(&dir);
+    dir.join(format!("screenshot-{stamp}.png"))
+}
+
+/// World bounds of what the scene shows (its regions' volumes, as placed).
+pub fn scene_bounds(regions: &SceneRegions) -> (Vec3, Vec3) {
+    let s = &regions.scene;
+    let mut out: Option<(Vec3, Vec3)> = None;
+    for r in &s.regions {
+        let (Some(v), Some(a)) = (s.volumes.get(r.volume), s.appearances.get(r.appearance)) else { continue };
+        let (lo, hi) = a.visible_bounds(v).unwrap_or_else(|| v.grid.world_bounds());
+        // The region map takes world to voxel; with the grid's own map it gives the
+        // dataset's placement.
+        let own_to_world = r.world_to_voxel.inverse() * v.grid.world_to_index();
+        for c in 0..8 {
+            let p = own_to_world.transform_point3(Vec3::new(
+                if c & 1 == 0 { lo.x } else { hi.x },
+                if c & 2 == 0 { lo.y } else { hi.y },
+                if c & 4 == 0 { lo.z } else { hi.z },
+            ));
+            out = Some(out.map_or((p, p), |(a, b)| (a.min(p), b.max(p))));
+        }
+    }
+    out.unwrap_or((Vec3::splat(-100.0), Vec3::splat(100.0)))
+}
+
+/// Frames newly loaded data.
+fn reframe(mut session: ResMut<Session>, mut cams: Query<&mut OrbitCamera>) {
+    if let Some((lo, hi)) = session.reframe.take()
+        && let Ok(mut orbit) = cams.single_mut()
+    {
+        orbit.frame(View::Oblique, lo, hi, 1.0);
+    }
+}
+
+/// Double-click centres the orbit on the first visible point under the cursor (picked
+/// with the CPU reference renderer).
+fn centre_on_double_click(
+    buttons: Res<ButtonInput<MouseButton>>,
+    windows: Query<&Window, With<PrimaryWindow>>,
+    time: Res<Time<Real>>,
+    pointer: Res<PointerInViewport>,
+    regions: Res<SceneRegions>,
+    mut last: Local<(f64, Vec2)>,
+    mut cams: Query<(&mut OrbitCamera, &Camera), With<MainCamera>>,
+) {
+    let Ok(window) = windows.single() else { return };
+    if !pointer.inside {
+        return;
+    }
+    let Some(cursor) = orbit::double_click(&buttons, window, time.elapsed_secs_f64(), &mut last) else { return };
+    let Ok((mut orbit, camera)) = cams.single_mut() else { return };
+    let scale = window.scale_factor();
+    let (origin, size) = match &camera.viewport {
+        Some(v) => (v.physical_position.as_vec2() / scale, v.physical_size.as_vec2() / scale),
+        None => (Vec2::ZERO, Vec2::new(window.width(), window.height())),
+    };
+    let p = cursor - origin;
+    let ray = orbit.camera().ray(p.x, p.y, size.x.max(1.0) as u32, size.y.max(1.0) as u32);
+    if let Ok(Some(hit)) = crate::reference::pick(&regions.scene, ray) {
+        orbit.target = hit.position;
+    }
+}
+
+/// Copies the app's background and switches to the camera.
+fn sync_view(state: Res<AppState>, mut cams: Query<(&mut Camera, &mut VolumeView), With<MainCamera>>) {
+    if !state.is_changed() {
+        return;
+    }
+    for (mut cam, mut view) in &mut cams {
+        let [r, g, b] = state.background;
+        cam.clear_color = Color::srgb(r, g, b).into();
+        let light = view.light;
+        *view = VolumeView { light, ..state.view };
+    }
+}
+
+/// Test automation: a screenshot after N frames (counted once loading is done), then
+/// exit as soon as it is written.
+fn automation(
+    mut state: ResMut<AppState>,
+    mut commands: Commands,
+    mut exit: MessageWriter<AppExit>,
+    loading: Query<(), With<loading::Loading>>,
+) {
+    let Some((after, path)) = state.screenshot_and_exit.clone() else { return };
+    if !loading.is_empty() {
+        return;
+    }
+    state.frames += 1;
+    if state.frames == after {
+        let _ = std::fs::remove_file(&path);
+        commands.spawn(Screenshot::primary_window()).observe(save_to_disk(path.clone()));
+    }
+    if state.frames > after && (path.exists() || state.frames > after + 20) {
+        exit.write(AppExit::Success);
+    }
+}
+
+/// Limits the 3D camera to the part of the window the panels leave free.
+pub fn set_viewport(camera: &mut Camera, window: &Window, free: bevy_egui::egui::Rect, zoom: f32) {
+    let scale = window.scale_factor() * zoom;
+    let pos = UVec2::new((free.min.x * scale).max(0.0) as u32, (free.min.y * scale).max(0.0) as u32);
+    let size = UVec2::new((free.width() * scale) as u32, (free.height() * scale) as u32)
+        .min(UVec2::new(window.physical_width(), window.physical_height()).saturating_sub(pos));
+    if size.x < 8 || size.y < 8 {
+        return;
+    }
+    let viewport = Viewport { physical_position: pos, physical_size: size, ..default() };
+    if camera.viewport.as_ref().is_none_or(|v| v.physical_position != pos || v.physical_size != size) {
+        camera.viewport = Some(viewport);
+    }
+}
+
+/// Runs the app.
+pub fn run(initial: Option<PathBuf>, screenshot_and_exit: Option<(u32, PathBuf)>, window: (u32, u32)) -> AppExit {
+    App::new()
+        .add_plugins(DefaultPlugins.set(WindowPlugin {
+            primary_window: Some(Window { title: "Focal".into(), resolution: window.into(), ..default() }),
+            ..default()
+        }))
+        .add_plugins(crate::FocalPlugins)
+        .add_plugins(FocalAppPlugin { initial, screenshot_and_exit })
+        .run()
+}

@@ -1,0 +1,358 @@
+//! The egui panels: menu bar, dataset, transfer function, rendering and camera panels,
+//! help, frame rate, errors and load progress.
+
+use bevy::diagnostic::{DiagnosticsStore, FrameTimeDiagnosticsPlugin};
+use bevy::prelude::*;
+use bevy::window::PrimaryWindow;
+use bevy_egui::egui::{self, Color32, RichText};
+use bevy_egui::{EguiContexts, egui::Ui};
+
+use super::loading::{DatasetOrigin, LoadRequest, Loading, Session};
+use super::orbit::{OrbitCamera, PointerInViewport};
+use super::{AppState, DialogPurpose, MainCamera, SHORTCUTS, scene_bounds, set_viewport, tf_editor};
+use crate::dataset::{Dataset, GpuVolume, SceneLight, SceneRegions};
+use crate::region::{Light, Lookup, Mode, View};
+use crate::transfer::presets;
+
+/// Everything the panels read and edit.
+#[allow(clippy::too_many_arguments)]
+pub fn ui(
+    mut contexts: EguiContexts,
+    mut state: ResMut<AppState>,
+    mut session: ResMut<Session>,
+    mut datasets: Query<(Entity, &mut Dataset, Option<&GpuVolume>, Option<&DatasetOrigin>, &Transform)>,
+    loading: Query<&Loading>,
+    mut cams: Query<(&mut OrbitCamera, &mut Camera), With<MainCamera>>,
+    windows: Query<&Window, With<PrimaryWindow>>,
+    diagnostics: Res<DiagnosticsStore>,
+    mut pointer: ResMut<PointerInViewport>,
+    mut light: ResMut<SceneLight>,
+    regions: Res<SceneRegions>,
+    mut load: MessageWriter<LoadRequest>,
+) -> Result {
+    let ctx = contexts.ctx_mut()?.clone();
+    let mut root = Ui::new(
+        ctx.clone(),
+        "focal_root".into(),
+        egui::UiBuilder::new().layer_id(egui::LayerId::background()).max_rect(ctx.viewport_rect()),
+    );
+
+    egui::Panel::top("menu").show(&mut root, |ui| {
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| {
+                if ui.button("Open file…  (Ctrl+O)").clicked() {
+                    state.dialog_purpose = DialogPurpose::Open;
+                    state.dialog.pick_file();
+                }
+                if ui.button("Open DICOM folder…").clicked() {
+                    state.dialog_purpose = DialogPurpose::Open;
+                    state.dialog.pick_directory();
+                }
+                if ui.button("Save scene…  (Ctrl+S)").clicked() {
+                    state.dialog_purpose = DialogPurpose::SaveScene;
+                    state.dialog.save_file();
+                }
+                if ui.button("Head phantom").clicked() {
+                    load.write(LoadRequest::Scene(super::default_scene(), Default::default()));
+                }
+            });
+            ui.menu_button("View", |ui| {
+                ui.checkbox(&mut state.show_help, "Help  (H)");
+                ui.checkbox(&mut state.show_fps, "Frame rate  (F)");
+            });
+            for l in &loading {
+                ui.separator();
+                ui.label(format!("Loading {}", short(&l.what)));
+                match l.progress.fraction() {
+                    Some(f) => ui.add(egui::ProgressBar::new(f).desired_width(160.0).show_percentage()),
+                    None => ui.spinner(),
+                };
+            }
+            if let Some(p) = &state.last_screenshot {
+                ui.separator();
+                ui.label(RichText::new(format!("screenshot: {}", p.display())).small());
+            }
+        });
+    });
+
+    let mut ds: Vec<_> = datasets.iter_mut().collect();
+    ds.sort_by_key(|(e, ..)| *e);
+    let selected = state.selected.min(ds.len().saturating_sub(1));
+    egui::Panel::left("controls").resizable(true).default_size(330.0).show(&mut root, |ui| {
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            egui::CollapsingHeader::new("Data").default_open(true).show(ui, |ui| {
+                for (i, (_, d, gpu, _, _)) in ds.iter_mut().enumerate() {
+                    ui.horizontal(|ui| {
+                        ui.checkbox(&mut d.visible, "");
+                        if ui.selectable_label(i == selected, &d.volume.name).clicked() {
+                            state.selected = i;
+                        }
+                    });
+                    if let Some(w) = gpu.and_then(|g| g.warning.as_ref()) {
+                        ui.label(RichText::new(format!("⚠ {w}")).color(Color32::YELLOW).small());
+                    }
+                }
+                if let Some((_, d, ..)) = ds.get(selected) {
+                    dataset_info(ui, d);
+                }
+            });
+            if let Some((_, d, ..)) = ds.get_mut(selected) {
+                egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| transfer_panel(ui, d, &mut state.editor));
+                egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| rendering_panel(ui, d, &mut state, &mut light));
+            }
+            egui::CollapsingHeader::new("Camera").default_open(true).show(ui, |ui| {
+                if let Ok((mut orbit, _)) = cams.single_mut() {
+                    camera_panel(ui, &mut orbit, scene_bounds(&regions));
+                }
+            });
+        });
+    });
+
+    // The rest of the window is the 3D viewport.
+    let free = root.available_rect_before_wrap();
+    if let (Ok((_, mut camera)), Ok(window)) = (cams.single_mut(), windows.single()) {
+        set_viewport(&mut camera, window, free, ctx.zoom_factor());
+    }
+    let over_free = ctx.pointer_hover_pos().is_some_and(|p| free.contains(p));
+    pointer.inside = over_free && !ctx.is_pointer_over_egui() && !ctx.egui_is_using_pointer();
+    pointer.height = free.height();
+
+    if state.show_help {
+        let mut open = true;
+        egui::Window::new("Help").open(&mut open).resizable(false).show(&ctx, |ui| {
+            egui::Grid::new("shortcuts").striped(true).show(ui, |ui| {
+                for (k, what) in SHORTCUTS {
+                    ui.label(RichText::new(*k).strong());
+                    ui.label(*what);
+                    ui.end_row();
+                }
+            });
+        });
+        state.show_help = open;
+    }
+    if state.show_fps {
+        let fps = diagnostics.get(&FrameTimeDiagnosticsPlugin::FPS).and_then(|d| d.smoothed()).unwrap_or(0.0);
+        let ms = diagnostics.get(&FrameTimeDiagnosticsPlugin::FRAME_TIME).and_then(|d| d.smoothed()).unwrap_or(0.0);
+        egui::Area::new("fps".into()).fixed_pos(free.right_top() + egui::vec2(-150.0, 8.0)).show(&ctx, |ui| {
+            ui.label(RichText::new(format!("{fps:.1} fps  {ms:.1} ms")).color(Color32::LIGHT_GREEN).monospace());
+        });
+    }
+    if let Some(e) = session.error.clone() {
+        let mut open = true;
+        egui::Window::new("Could not open").open(&mut open).show(&ctx, |ui| {
+            ui.label(RichText::new(e).color(Color32::LIGHT_RED));
+            ui.label("The data shown before is still there.");
+        });
+        if !open {
+            session.error = None;
+        }
+    }
+
+    // File dialogs.
+    state.dialog.update(&ctx);
+    if let Some(path) = state.dialog.take_picked() {
+        match state.dialog_purpose {
+            DialogPurpose::Open => {
+                load.write(LoadRequest::Path(path));
+            }
+            DialogPurpose::SaveScene => {
+                let result = save_scene(
+                    &path,
+                    &ds_states(&datasets),
+                    cams.single().map(|(o, _)| o.camera()).ok(),
+                    state.background,
+                    light.0,
+                    &session,
+                );
+                if let Err(e) = result {
+                    session.error = Some(e);
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn short(s: &str) -> String {
+    std::path::Path::new(s).file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| s.to_string())
+}
+
+fn dataset_info(ui: &mut Ui, d: &Dataset) {
+    let v = &d.volume;
+    let g = &v.grid;
+    let units = v.values.units.clone().map(|u| format!(" {u}")).unwrap_or_default();
+    egui::Grid::new("info").num_columns(2).show(ui, |ui| {
+        let mut row = |k: &str, val: String| {
+            ui.label(RichText::new(k).weak());
+            ui.label(val);
+            ui.end_row();
+        };
+        row("format", format!("{} ({})", v.source.format, v.source.sample_type));
+        row("size", crate::volume::grid::fmt_dims(g.dims));
+        row("spacing", format!("{:.3} × {:.3} × {:.3} mm", g.spacing.x, g.spacing.y, g.spacing.z));
+        row("orientation", g.orientation_code());
+        row("values", format!("{:.1} … {:.1}{units}", v.stats.min, v.stats.max));
+        row("mean ± sd", format!("{:.1} ± {:.1}", v.stats.mean, v.stats.std_dev));
+        for (k, val) in v.source.details.iter().take(6) {
+            row(k, val.clone());
+        }
+    });
+}
+
+fn transfer_panel(ui: &mut Ui, d: &mut Dataset, editor: &mut tf_editor::EditorState) {
+    let hist = d.volume.stats.histogram.clone();
+    match &mut d.appearance.lookup {
+        Lookup::Transfer(tf) => {
+            egui::ComboBox::from_label("preset").selected_text(tf.name.clone()).show_ui(ui, |ui| {
+                for key in presets::names() {
+                    if let Ok(p) = presets::builtin(key)
+                        && ui.selectable_label(tf.name == p.name, &p.name).clicked()
+                    {
+                        *tf = p;
+                    }
+                }
+            });
+            if let (Some(u), Some(v)) = (&tf.units, &d.volume.values.units)
+                && u != v
+            {
+                ui.label(RichText::new(format!("⚠ preset for {u}, data in {v}")).color(Color32::YELLOW));
+            }
+            let mut edited = tf.clone();
+            if tf_editor::editor(ui, &mut edited, &hist, editor) {
+                *tf = edited;
+            }
+        }
+        Lookup::Labels(styles) => {
+            let table = d.labels.clone();
+            egui::ScrollArea::vertical().max_height(260.0).show(ui, |ui| {
+                for (id, s) in styles.styles.iter_mut().filter(|(id, _)| **id != 0) {
+                    ui.horizontal(|ui| {
+                        ui.checkbox(&mut s.visible, "");
+                        ui.color_edit_button_rgb(&mut s.color);
+                        ui.add(egui::Slider::new(&mut s.opacity, 0.0..=1.0).show_value(false));
+                        let name = table.as_ref().map(|t| t.name(*id)).unwrap_or_else(|| format!("label {id}"));
+                        ui.label(name);
+                    });
+                }
+            });
+        }
+    }
+}
+
+fn rendering_panel(ui: &mut Ui, d: &mut Dataset, state: &mut AppState, light: &mut SceneLight) {
+    let a = &mut d.appearance;
+    egui::ComboBox::from_label("mode").selected_text(mode_name(a.mode)).show_ui(ui, |ui| {
+        for m in Mode::ALL {
+            ui.selectable_value(&mut a.mode, m, mode_name(m));
+        }
+    });
+    if a.mode == Mode::Iso {
+        let (lo, hi) = (d.volume.stats.min, d.volume.stats.max);
+        ui.add(egui::Slider::new(&mut a.iso_value, lo..=hi).text("iso-value"));
+    }
+    ui.add(egui::Slider::new(&mut a.step, 0.1..=2.0).logarithmic(true).text("step (voxels)"));
+    ui.checkbox(&mut a.shading.enabled, "shading");
+    if a.shading.enabled {
+        ui.add(egui::Slider::new(&mut a.shading.ambient, 0.0..=1.0).text("ambient"));
+        ui.add(egui::Slider::new(&mut a.shading.diffuse, 0.0..=1.0).text("diffuse"));
+        ui.add(egui::Slider::new(&mut a.shading.specular, 0.0..=1.0).text("specular"));
+        ui.add(egui::Slider::new(&mut a.shading.shininess, 1.0..=128.0).logarithmic(true).text("shininess"));
+    }
+    ui.horizontal(|ui| {
+        ui.label("light");
+        let mut fixed = matches!(light.0, Light::Direction(_));
+        if ui.radio_value(&mut fixed, false, "headlight").changed() || ui.radio_value(&mut fixed, true, "fixed").changed() {
+            light.0 = if fixed { Light::Direction(Vec3::new(0.4, 0.6, 0.7)) } else { Light::Headlight };
+        }
+    });
+    if let Light::Direction(dir) = &mut light.0 {
+        let (mut az, mut el) = ((-dir.x).atan2(dir.y).to_degrees(), dir.z.clamp(-1.0, 1.0).asin().to_degrees());
+        let c1 = ui.add(egui::Slider::new(&mut az, -180.0..=180.0).text("light azimuth")).changed();
+        let c2 = ui.add(egui::Slider::new(&mut el, -89.0..=89.0).text("light elevation")).changed();
+        if c1 || c2 {
+            let (a, e) = (az.to_radians(), el.to_radians());
+            *dir = Vec3::new(-a.sin() * e.cos(), a.cos() * e.cos(), e.sin());
+        }
+    }
+    ui.horizontal(|ui| {
+        ui.label("background");
+        ui.color_edit_button_rgb(&mut state.background);
+    });
+    ui.checkbox(&mut state.view.jitter, "jitter ray starts");
+    ui.checkbox(&mut state.view.skip_empty, "skip empty space");
+    ui.checkbox(&mut state.view.early_termination, "early ray termination");
+}
+
+fn camera_panel(ui: &mut Ui, orbit: &mut OrbitCamera, bounds: (Vec3, Vec3)) {
+    ui.horizontal_wrapped(|ui| {
+        for (label, view) in [
+            ("front", View::Anterior),
+            ("back", View::Posterior),
+            ("left", View::Left),
+            ("right", View::Right),
+            ("top", View::Superior),
+            ("bottom", View::Inferior),
+            ("oblique", View::Oblique),
+        ] {
+            if ui.button(label).clicked() {
+                orbit.frame(view, bounds.0, bounds.1, 1.0);
+            }
+        }
+    });
+    ui.horizontal(|ui| {
+        if ui.button("reset").clicked() {
+            orbit.frame(View::Oblique, bounds.0, bounds.1, 1.0);
+        }
+        ui.checkbox(&mut orbit.orthographic, "orthographic");
+    });
+    ui.add(egui::Slider::new(&mut orbit.fov_deg, 10.0..=90.0).text("field of view °"));
+    ui.add(egui::Slider::new(&mut orbit.azimuth_deg, 0.0..=360.0).text("azimuth °"));
+    ui.add(egui::Slider::new(&mut orbit.elevation_deg, -89.0..=89.0).text("elevation °"));
+}
+
+fn mode_name(m: Mode) -> &'static str {
+    match m {
+        Mode::Dvr => "DVR",
+        Mode::Mip => "MIP",
+        Mode::MinIp => "MinIP",
+        Mode::XRay => "X-ray",
+        Mode::GradientDvr => "gradient-modulated DVR",
+        Mode::Iso => "iso-surface",
+    }
+}
+
+type DatasetRow<'a> = (&'a DatasetOrigin, &'a Dataset, &'a Transform);
+
+fn ds_states<'a>(
+    datasets: &'a Query<(Entity, &mut Dataset, Option<&GpuVolume>, Option<&DatasetOrigin>, &Transform)>,
+) -> Vec<DatasetRow<'a>> {
+    let mut rows: Vec<_> = datasets.iter().filter_map(|(e, d, _, o, t)| o.map(|o| (e, (o, d, t)))).collect();
+    rows.sort_by_key(|(e, _)| *e);
+    rows.into_iter().map(|(_, r)| r).collect()
+}
+
+fn save_scene(
+    path: &std::path::Path,
+    rows: &[DatasetRow],
+    camera: Option<crate::region::Camera>,
+    background: [f32; 3],
+    light: Light,
+    session: &Session,
+) -> Result<(), String> {
+    use crate::scene::save::{DatasetState, scene_file};
+    let states: Vec<DatasetState> = rows
+        .iter()
+        .map(|(o, d, t)| DatasetState {
+            spec: &o.0,
+            appearance: &d.appearance,
+            translation: t.translation,
+            rotation: t.rotation,
+            visible: d.visible,
+        })
+        .collect();
+    let camera = camera.ok_or("no camera")?;
+    let size = session.scene.as_ref().map(|s| s.size).unwrap_or((512, 512));
+    let scene = scene_file(&states, &camera, background, light, size, &session.base);
+    let path = if path.extension().is_some_and(|e| e == "ron") { path.to_path_buf() } else { path.with_extension("ron") };
+    std::fs::write(&path, scene.to_ron()?).map_err(|e| format!("{}: {e}", path.display()))
+}

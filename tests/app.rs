@@ -1,0 +1,100 @@
+//! The app: background loading as headless ECS (no window, no GPU), and the whole app in
+//! a virtual X server (Xvfb) on software Vulkan, checked by its screenshot.
+
+mod common;
+
+use std::process::Command;
+use std::time::Duration;
+
+use bevy::prelude::*;
+use common::{data, scratch};
+use focal::FocalCorePlugins;
+use focal::dataset::Dataset;
+use focal::ui::loading::{LoadRequest, LoadingPlugin, Session};
+
+fn headless_app() -> App {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, TransformPlugin, FocalCorePlugins, LoadingPlugin));
+    app
+}
+
+/// Updates until `done` holds (loads run on the task pool).
+fn run_until(app: &mut App, done: impl Fn(&mut World) -> bool) {
+    for _ in 0..600 {
+        app.update();
+        if done(app.world_mut()) {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    panic!("timed out");
+}
+
+fn dataset_names(world: &mut World) -> Vec<String> {
+    world.query::<&Dataset>().iter(world).map(|d| d.volume.name.clone()).collect()
+}
+
+#[test]
+fn files_load_in_the_background_and_failures_keep_the_data() {
+    let mut app = headless_app();
+    app.world_mut().write_message(LoadRequest::Path(data("ct/fuel.nii.gz")));
+    run_until(&mut app, |w| !dataset_names(w).is_empty());
+    assert_eq!(dataset_names(app.world_mut()), vec!["fuel"]);
+    let session = app.world().resource::<Session>();
+    assert!(session.error.is_none() && session.reframe.is_some());
+
+    // A broken file: an error to show, and the fuel data stays.
+    let dir = scratch("app-bad");
+    let bad = dir.join("broken.nrrd");
+    std::fs::write(&bad, "NRRD0004\ntype: short\n").unwrap();
+    app.world_mut().write_message(LoadRequest::Path(bad));
+    run_until(&mut app, |w| w.resource::<Session>().error.is_some());
+    let e = app.world().resource::<Session>().error.clone().unwrap();
+    assert!(e.contains("broken.nrrd"), "{e}");
+    assert_eq!(dataset_names(app.world_mut()), vec!["fuel"]);
+
+    // A label volume opens as labels (its table lies beside it).
+    app.world_mut().write_message(LoadRequest::Path(data("labels/aal.nii.gz")));
+    run_until(&mut app, |w| dataset_names(w) == vec!["aal"]);
+    let world = app.world_mut();
+    let d = world.query::<&Dataset>().single(world).unwrap();
+    assert!(matches!(d.appearance.lookup, focal::region::Lookup::Labels(_)));
+    assert_eq!(d.labels.as_ref().map(|t| t.name(1)), Some("Precentral_L".to_string()));
+}
+
+#[test]
+fn scene_files_load_with_all_their_datasets() {
+    let mut app = headless_app();
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/ch2_aal.ron");
+    app.world_mut().write_message(LoadRequest::Path(scene));
+    run_until(&mut app, |w| dataset_names(w).len() == 2);
+    // The scene's regions follow: one per visible dataset.
+    app.update();
+    assert_eq!(app.world().resource::<focal::dataset::SceneRegions>().scene.regions.len(), 2);
+}
+
+#[test]
+fn the_app_opens_a_window_and_shows_the_phantom() {
+    if Command::new("xvfb-run").arg("--help").output().is_err() {
+        panic!("xvfb-run is missing (scripts/test.sh installs xvfb)");
+    }
+    let dir = scratch("app-window");
+    let shot = dir.join("app.png");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_focal"))
+        .args(["--frames", "2", "--window", "640x400", "--screenshot"])
+        .arg(&shot)
+        .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&shot).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (640, 400));
+    // The left panel is drawn (grey UI pixels) and the viewport shows the phantom
+    // (warm skin/bone colours) on black.
+    let panel = img.get_pixel(100, 300);
+    assert!(panel[0] > 15 && panel[0] < 80, "panel {panel:?}");
+    let warm = img.pixels().filter(|p| p[0] > 150 && p[0] as u32 > p[2] as u32 + 20).count();
+    assert!(warm > 2000, "only {warm} phantom-coloured pixels");
+}
