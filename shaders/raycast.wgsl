@@ -30,16 +30,6 @@ fn is_projection(mode: u32) -> bool {
     return mode == MODE_MIP || mode == MODE_MIN_IP || mode == MODE_X_RAY;
 }
 
-// The colour of a sample: label table or transfer function.
-fn region_rgba(r: Region, v: f32, q: vec3<f32>) -> vec4<f32> {
-#ifdef HAS_LABELS
-    if (r.flags & REGION_LABELS) != 0u {
-        return classify_label(r, nearest_code(r, q), scene.lut_atlas_width);
-    }
-#endif
-    return classify(r, v, scene.lut_atlas_width);
-}
-
 // Shaded colour of a DVR or iso sample at q.
 fn shaded(r: Region, c: vec3<f32>, q: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 #ifdef HAS_SHADING
@@ -53,7 +43,16 @@ fn shaded(r: Region, c: vec3<f32>, q: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 
 // One DVR (or label, or gradient-modulated) sample composited under acc.
 fn dvr_sample(r: Region, q: vec3<f32>, ratio: f32, dir: vec3<f32>, acc: vec4<f32>) -> vec4<f32> {
-    let rgba = region_rgba(r, trilinear(r, q), q);
+    var rgba: vec4<f32>;
+#ifdef HAS_LABELS
+    if (r.flags & REGION_LABELS) != 0u {
+        rgba = classify_label(r, nearest_code(r, q), scene.lut_atlas_width);
+    } else {
+        rgba = classify(r, trilinear(r, q), scene.lut_atlas_width);
+    }
+#else
+    rgba = classify(r, trilinear(r, q), scene.lut_atlas_width);
+#endif
     if rgba.a <= 0.0 {
         return acc;
     }
@@ -269,19 +268,16 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #endif
             {
 #ifdef HAS_DVR
-                let occupancy = (r.flags & REGION_OCCUPANCY) != 0u;
+                // With skipping off this is plain marching: every sample is classified.
+                let occupancy = skip && (r.flags & REGION_OCCUPANCY) != 0u;
                 loop {
                     if kk > k_end || acc.a >= stop {
                         break;
                     }
                     let q = q0 + dq * (kk - k);
                     if occupancy && !brick_occupied(r, q) {
-                        if skip {
-                            let tk = t_start + (kk + j) * step;
-                            kk = max(kk + 1.0, ceil((brick_exit(r, q, qd, tk) - t_start) / step - j));
-                        } else {
-                            kk += 1.0;
-                        }
+                        let tk = t_start + (kk + j) * step;
+                        kk = max(kk + 1.0, ceil((brick_exit(r, q, qd, tk) - t_start) / step - j));
                         continue;
                     }
                     acc = dvr_sample(r, q, ratios[s], ray.dir, acc);
@@ -326,7 +322,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
             }
 #endif
 #ifdef HAS_DVR
-            if (r.flags & REGION_OCCUPANCY) == 0u || brick_occupied(r, q) {
+            if !skip || (r.flags & REGION_OCCUPANCY) == 0u || brick_occupied(r, q) {
                 acc = dvr_sample(r, q, ratios[s], ray.dir, acc);
             }
 #endif

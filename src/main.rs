@@ -36,8 +36,10 @@ struct Args {
 enum Command {
     /// Print what a volume file holds: format, grid, orientation, values, histogram.
     Info(cli::info::InfoArgs),
-    /// Render a volume (or phantom) to a PNG.
+    /// Render scene files, or a volume (or phantom), to PNG.
     Render(cli::render::RenderArgs),
+    /// GPU frame times of fixed scenes, with ratios measured in the same run.
+    Bench(cli::bench::BenchArgs),
 }
 
 /// Whether a window can be opened (an X or Wayland display).
@@ -50,6 +52,7 @@ fn main() -> ExitCode {
     let result = match args.command {
         Some(Command::Info(a)) => cli::info::run(&a),
         Some(Command::Render(a)) => cli::render::run(&a),
+        Some(Command::Bench(a)) => cli::bench::run(&a),
         None if args.headless || !has_display() => cli::render::run_headless(args.volume.as_deref(), &args.out),
         None => {
             let automation = args.screenshot.clone().zip(args.frames).map(|(p, n)| (n, p));

@@ -1,4 +1,5 @@
 //! Subcommands of the `focal` binary.
 
+pub mod bench;
 pub mod info;
 pub mod render;

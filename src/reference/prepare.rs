@@ -65,14 +65,7 @@ impl<'a> PreparedRegion<'a> {
         };
         // Label volumes are composited like DVR whatever the mode says.
         let mode = if labels { Mode::Dvr } else { appearance.mode };
-        let occupancy = match (&lookup, mode) {
-            (PreparedLookup::Transfer { lut, .. }, Mode::Dvr | Mode::GradientDvr) => {
-                let bricks = volume.bricks();
-                let map = &volume.values;
-                Some((bricks, bricks.occupancy(|lo, hi| lut.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0)))
-            }
-            _ => None,
-        };
+        let occupancy = appearance.brick_occupancy(volume).map(|occ| (volume.bricks(), occ));
         let a = Mat3::from(region.world_to_voxel.matrix3);
         let index_to_native = volume.grid.direction * Mat3::from_diagonal(volume.grid.spacing);
         let reference_length = volume.grid.min_spacing();

@@ -112,23 +112,32 @@ impl Appearance {
         Self { mode, lookup: Lookup::Transfer(tf), shading: Shading::default(), step: 0.5, iso_value: 0.0 }
     }
 
-    /// World-space bounds of what this appearance shows of `volume` (the bricks with any
-    /// opacity; the whole box for projections, which show every sample).
-    pub fn visible_bounds(&self, volume: &Volume) -> Option<(Vec3, Vec3)> {
+    /// Which bricks of `volume` can contribute under this appearance, for the modes that
+    /// composite samples (DVR, gradient-modulated DVR, label volumes): a brick whose code
+    /// range maps only to zero opacity adds nothing. `None` for modes that look at every
+    /// sample (projections, iso-surfaces).
+    pub fn brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {
         let bricks = volume.bricks();
-        let keep = match (&self.lookup, self.mode.is_projection()) {
-            (Lookup::Transfer(_), true) => return Some(volume.grid.world_bounds()),
-            (Lookup::Transfer(tf), false) => {
+        match &self.lookup {
+            Lookup::Transfer(tf) if matches!(self.mode, Mode::Dvr | Mode::GradientDvr) => {
                 let lut = Lut::for_volume(tf, volume);
                 let map = &volume.values;
-                bricks.occupancy(|lo, hi| lut.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0)
+                Some(bricks.occupancy(|lo, hi| lut.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0))
             }
-            (Lookup::Labels(styles), _) => {
+            Lookup::Transfer(_) => None,
+            Lookup::Labels(styles) => {
                 let table = styles.bake(volume.stats.code_max as usize + 1);
-                bricks.occupancy(|lo, hi| table.get(lo as usize..=hi as usize).is_some_and(|t| t.iter().any(|c| c[3] > 0.0)))
+                Some(bricks.occupancy(|lo, hi| table.get(lo as usize..=hi as usize).is_some_and(|t| t.iter().any(|c| c[3] > 0.0))))
             }
-        };
-        bricks
+        }
+    }
+
+    /// World-space bounds of what this appearance shows of `volume` (the bricks with any
+    /// opacity; the whole box for projections and iso-surfaces).
+    pub fn visible_bounds(&self, volume: &Volume) -> Option<(Vec3, Vec3)> {
+        let Some(keep) = self.brick_occupancy(volume) else { return Some(volume.grid.world_bounds()) };
+        volume
+            .bricks()
             .bounds_where(&keep)
             .map(|(lo, hi)| volume.grid.index_box_world_bounds(lo.max(Vec3::splat(-0.5)), hi.min(volume.dims().as_vec3() - 0.5)))
     }
