@@ -83,7 +83,7 @@ fn the_app_opens_a_window_and_shows_the_phantom() {
     let out = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1024x768x24"])
         .arg(env!("CARGO_BIN_EXE_focal"))
-        .args(["--frames", "2", "--window", "640x400", "--screenshot"])
+        .args(["--frames", "4", "--window", "640x400", "--screenshot"])
         .arg(&shot)
         .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
         .output()
@@ -94,7 +94,7 @@ fn the_app_opens_a_window_and_shows_the_phantom() {
     // The left panel is drawn (grey UI pixels) and the viewport shows the phantom
     // (warm skin/bone colours) on black.
     let panel = img.get_pixel(100, 300);
-    assert!(panel[0] > 15 && panel[0] < 80, "panel {panel:?}");
+    assert!(panel[0] > 15 && panel[0] < 80, "panel {panel:?} in {}", shot.display());
     let warm = img.pixels().filter(|p| p[0] > 150 && p[0] as u32 > p[2] as u32 + 20).count();
     assert!(warm > 2000, "only {warm} phantom-coloured pixels");
 }

@@ -23,6 +23,8 @@ pub mod pipeline;
 pub mod shaders;
 pub mod upload;
 
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::prelude::*;
 use bevy::render::extract_component::{ExtractComponentPlugin, UniformComponentPlugin};
@@ -38,11 +40,37 @@ use crate::dataset::gpu_fit::{GpuLimits, fit_datasets};
 /// The volume ray caster.
 pub struct VolumeRenderPlugin;
 
+/// Render progress shared by the main and render worlds: how many times the ray-cast
+/// pass has drawn volumes and whether every queued pipeline (ours, egui's, …) is built.
+/// The app's automation waits for both before it takes a screenshot.
+#[derive(Resource, Clone, Default)]
+pub struct RenderProgress(std::sync::Arc<(AtomicU64, AtomicBool)>);
+
+impl RenderProgress {
+    pub fn volumes_drawn(&self) -> u64 {
+        self.0.0.load(Ordering::Relaxed)
+    }
+
+    pub fn pipelines_settled(&self) -> bool {
+        self.0.1.load(Ordering::Relaxed)
+    }
+
+    pub(crate) fn count_draw(&self) {
+        self.0.0.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+fn record_pipeline_state(progress: Res<RenderProgress>, cache: Res<bevy::render::render_resource::PipelineCache>) {
+    progress.0.1.store(cache.waiting_pipelines().next().is_none(), Ordering::Relaxed);
+}
+
 impl Plugin for VolumeRenderPlugin {
     fn build(&self, app: &mut App) {
         shaders::register(app);
 
+        let progress = RenderProgress::default();
         app.init_resource::<GpuLimits>()
+            .insert_resource(progress.clone())
             .add_plugins((ExtractComponentPlugin::<VolumeView>::default(), UniformComponentPlugin::<GpuSettings>::default()))
             .add_systems(PostUpdate, (extract::request_depth_binding, fit_datasets.before(crate::dataset::RegionSystems::Collect)));
 
@@ -50,13 +78,18 @@ impl Plugin for VolumeRenderPlugin {
             return;
         };
         render_app
+            .insert_resource(progress)
             .init_resource::<upload::GpuScene>()
             .init_resource::<bevy::render::render_resource::SpecializedRenderPipelines<pipeline::RaycastPipeline>>()
             .add_systems(bevy::render::ExtractSchedule, extract::extract_scene)
             .add_systems(RenderStartup, pipeline::init_pipeline)
             .add_systems(
                 Render,
-                (upload::upload_scene.in_set(RenderSystems::PrepareResources), pipeline::prepare_pipelines.in_set(RenderSystems::Prepare)),
+                (
+                    upload::upload_scene.in_set(RenderSystems::PrepareResources),
+                    pipeline::prepare_pipelines.in_set(RenderSystems::Prepare),
+                    record_pipeline_state.in_set(RenderSystems::Cleanup),
+                ),
             )
             .add_systems(Core3d, pass::raycast_pass.after(Core3dSystems::MainPass).before(Core3dSystems::EarlyPostProcess));
     }

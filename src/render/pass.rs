@@ -26,6 +26,7 @@ pub fn raycast_pass(
     view_uniforms: Res<ViewUniforms>,
     settings: Res<ComponentUniforms<GpuSettings>>,
     scene: Res<GpuScene>,
+    progress: Res<super::RenderProgress>,
     mut ctx: RenderContext,
 ) {
     let (target, depth, view_offset, settings_index, pipeline_id, camera) = view.into_inner();
@@ -81,4 +82,5 @@ pub fn raycast_pass(
     pass.set_pipeline(render_pipeline);
     pass.set_bind_group(0, &bind_group, &[view_offset.offset, settings_index.index()]);
     pass.draw(0..3, 0..1);
+    progress.count_draw();
 }

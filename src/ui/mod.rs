@@ -321,16 +321,19 @@ fn sync_view(state: Res<AppState>, mut cams: Query<(&mut Camera, &mut VolumeView
     }
 }
 
-/// Test automation: a screenshot after N frames (counted once loading is done), then
-/// exit as soon as it is written.
+/// Test automation: a screenshot after N frames (counted once loading is done, the ray
+/// caster has drawn the volumes and no pipeline is still compiling, so the shot never shows a half-built first frame),
+/// then exit as soon as it is written.
 fn automation(
     mut state: ResMut<AppState>,
     mut commands: Commands,
     mut exit: MessageWriter<AppExit>,
     loading: Query<(), With<loading::Loading>>,
+    progress: Option<Res<crate::render::RenderProgress>>,
 ) {
     let Some((after, path)) = state.screenshot_and_exit.clone() else { return };
-    if !loading.is_empty() {
+    let settled = progress.is_some_and(|p| p.volumes_drawn() > 0 && p.pipelines_settled());
+    if !loading.is_empty() || !settled {
         return;
     }
     state.frames += 1;
