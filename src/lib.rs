@@ -2,12 +2,13 @@
 //!
 //! The crate is organised by technique (see `../shared/DESIGN.md` and the README):
 //! [`volume`] holds the data model, readers and phantoms; [`transfer`] the transfer
-//! functions; [`region`] the geometry every renderer shares; [`reference`] the CPU
+//! functions; [`region`] the geometry every renderer shares; [`lens`] the magic volume lenses; [`reference`] the CPU
 //! reference renderer; [`dataset`] the dataset entities that become regions; [`render`]
 //! the GPU ray caster that packs and draws them; [`scene`] scene files; [`ui`] the
 //! desktop app.
 
 pub mod dataset;
+pub mod lens;
 pub mod reference;
 pub mod region;
 pub mod render;
@@ -24,7 +25,7 @@ pub struct FocalCorePlugins;
 
 impl PluginGroup for FocalCorePlugins {
     fn build(self) -> PluginGroupBuilder {
-        PluginGroupBuilder::start::<Self>().add(dataset::DatasetPlugin)
+        PluginGroupBuilder::start::<Self>().add(dataset::DatasetPlugin).add(lens::LensPlugin)
     }
 }
 

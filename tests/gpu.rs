@@ -10,6 +10,8 @@
 //! pixels within 6 levels; a few pixels where a ray grazes a steep edge may differ more.
 
 mod common;
+#[path = "gpu/lenses.rs"]
+mod lenses;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
@@ -311,7 +313,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [(&str, fn(&mut Gpu)); 7] = [
+    let tests: [(&str, fn(&mut Gpu)); 11] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -319,6 +321,10 @@ fn main() {
         ("meshes_and_volume_mix_by_depth", meshes_and_volume_mix_by_depth),
         ("two_datasets_in_one_scene", two_datasets_in_one_scene),
         ("oversized_volumes_are_reduced_with_a_warning", oversized_volumes_are_reduced_with_a_warning),
+        ("lenses_match_the_reference", lenses::lenses_match_the_reference),
+        ("lens_ray_directions_match_the_reference", lenses::ray_directions_match_the_reference),
+        ("magnifier_scales_a_sphere_by_m_squared", lenses::magnifier_scales_a_sphere_by_m_squared),
+        ("outside_the_lens_the_image_is_unchanged", lenses::outside_the_lens_the_image_is_unchanged),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

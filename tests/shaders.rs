@@ -7,11 +7,17 @@ use std::path::Path;
 use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage, ShaderType};
 
 const BEVY_VIEW: &str = "#define_import_path bevy_render::view
-struct View { world_from_clip: mat4x4<f32>, world_position: vec3<f32> }";
+struct View {
+    world_from_clip: mat4x4<f32>,
+    world_from_view: mat4x4<f32>,
+    clip_from_view: mat4x4<f32>,
+    world_position: vec3<f32>,
+    viewport: vec4<f32>,
+}";
 const BEVY_FULLSCREEN: &str = "#define_import_path bevy_core_pipeline::fullscreen_vertex_shader
 struct FullscreenVertexOutput { @builtin(position) position: vec4<f32>, @location(0) uv: vec2<f32> }";
 
-const MODULES: [&str; 8] = ["types", "bindings", "camera", "regions", "sampling", "transfer", "shading", "compositing"];
+const MODULES: [&str; 9] = ["types", "bindings", "camera", "lens", "regions", "sampling", "transfer", "shading", "compositing"];
 
 fn read(rel: &str) -> String {
     std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
@@ -30,7 +36,8 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 7] = ["HAS_DVR", "HAS_GRADIENT_MODULATION", "HAS_LABELS", "HAS_PROJECTION", "HAS_ISO", "HAS_SHADING", "MULTI_REGION"];
+const DEFS: [&str; 8] =
+    ["HAS_DVR", "HAS_GRADIENT_MODULATION", "HAS_LABELS", "HAS_PROJECTION", "HAS_ISO", "HAS_SHADING", "MULTI_REGION", "HAS_LENSES"];
 
 #[test]
 fn every_shader_variant_composes_and_validates() {

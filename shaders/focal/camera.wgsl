@@ -23,13 +23,20 @@ fn pixel_ray(uv: vec2<f32>) -> Ray {
     return Ray(near, normalize(far - near));
 }
 
-// Ray parameter of the scene surface behind a pixel (infinity where there is none).
+// Ray parameter of the scene surface behind a pixel (infinity where there is none):
+// where the ray reaches the surface's depth along the view axis, which also holds for
+// rays bent by lenses.
 fn scene_depth_t(ray: Ray, uv: vec2<f32>, depth: f32) -> f32 {
     if depth <= 0.0 {
         return 3.4e38;
     }
     let ndc = vec2(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);
-    return dot(unproject(vec3(ndc, depth)) - ray.origin, ray.dir);
+    let forward = -view.world_from_view[2].xyz;
+    let along = dot(ray.dir, forward);
+    if along <= 1e-6 {
+        return 3.4e38;
+    }
+    return dot(unproject(vec3(ndc, depth)) - ray.origin, forward) / along;
 }
 
 // Deterministic jitter in [0, 1).

@@ -29,11 +29,26 @@ struct Region {
     pad_c: f32,
 }
 
+struct Lens {
+    // kind, shape, border profile, outline vertex count
+    codes: vec4<u32>,
+    // centre (xy, lens units), focus radius, border width
+    geometry: vec4<f32>,
+    // magnifier: plane distance, kappa, magnification; angular: half angle, whole view
+    params: vec4<f32>,
+}
+
+const MAX_LENSES: u32 = 4u;
+const LENS_DATA: u32 = 16u;
+
 struct Settings {
     light: vec4<f32>,
     flags: u32,
     frame: u32,
+    lens_count: u32,
     pad: u32,
+    lenses: array<Lens, 4>,
+    lens_data: array<vec4<f32>, 64>,
 }
 
 struct SceneInfo {
@@ -58,6 +73,7 @@ const REGION_OCCUPANCY: u32 = 4u;
 const VIEW_JITTER: u32 = 1u;
 const VIEW_SKIP_EMPTY: u32 = 2u;
 const VIEW_EARLY_TERMINATION: u32 = 4u;
+const VIEW_DEBUG_RAYS: u32 = 8u;
 
 // Accumulated opacity at which a ray stops (reference: trace::EARLY_TERMINATION).
 const EARLY_TERMINATION: f32 = 0.99;

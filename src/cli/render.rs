@@ -154,6 +154,7 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
             visible: true,
         }],
         camera,
+        lenses: Vec::new(),
         frames: Vec::new(),
     })
 }

@@ -15,6 +15,7 @@ use rayon::prelude::*;
 pub use image::RenderedImage;
 pub use trace::Traced;
 
+use crate::lens::{Lens, ResolvedLens, Screen, lens_ray};
 pub use crate::region::RenderScene;
 use crate::region::{Camera, Ray};
 use prepare::PreparedRegion;
@@ -45,18 +46,31 @@ pub fn prepare(scene: &RenderScene) -> Result<Vec<PreparedRegion<'_>>, String> {
 
 /// Renders `scene` seen by `camera` into a `width × height` image.
 pub fn render(scene: &RenderScene, camera: &Camera, width: u32, height: u32) -> Result<RenderedImage, String> {
+    render_lensed(scene, camera, &[], width, height)
+}
+
+/// Renders `scene` seen by `camera` through `lenses` (in order, the last on top).
+pub fn render_lensed(scene: &RenderScene, camera: &Camera, lenses: &[Lens], width: u32, height: u32) -> Result<RenderedImage, String> {
     if width == 0 || height == 0 {
         return Err(format!("image size {width}×{height} is empty"));
     }
+    for lens in lenses {
+        lens.validate().map_err(|e| format!("{} lens: {e}", lens.kind_name()))?;
+    }
+    let screen = Screen::new(width, height);
+    let bounds = scene.bounding_sphere();
+    let resolved: Vec<ResolvedLens> = lenses.iter().map(|l| crate::lens::stack::resolve(l, camera, screen, bounds)).collect();
     let regions = prepare(scene)?;
     let [r, g, b] = crate::transfer::color::srgb3_to_linear(scene.background);
     let bg = Vec4::new(r, g, b, 1.0);
     let pixels: Vec<Traced> = (0..height)
         .into_par_iter()
         .flat_map_iter(|y| {
-            let regions = &regions;
+            let (regions, resolved) = (&regions, &resolved);
             (0..width).map(move |x| {
-                let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5, width, height);
+                let Some(ray) = lens_ray(camera, screen, resolved, x as f32 + 0.5, y as f32 + 0.5) else {
+                    return Traced::EMPTY;
+                };
                 let j = if scene.jitter { trace::jitter(x, y, 0) } else { 0.5 };
                 trace::trace(regions, scene.light, ray, j, DEPTH_THRESHOLD, false)
             })

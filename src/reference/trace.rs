@@ -46,6 +46,11 @@ pub struct Traced {
     pub samples: u32,
 }
 
+impl Traced {
+    /// A pixel without a ray.
+    pub const EMPTY: Traced = Traced { color: Vec4::ZERO, value: f32::NAN, depth: f32::INFINITY, region: None, samples: 0 };
+}
+
 /// Per-region state along the ray.
 #[derive(Clone, Copy)]
 struct State {

@@ -43,3 +43,23 @@ impl RenderScene {
         RenderScene { volumes: vec![volume], regions: vec![region], appearances: vec![appearance], ..Default::default() }
     }
 }
+
+impl RenderScene {
+    /// Bounding sphere (centre, radius) of the volumes the regions show; a unit sphere
+    /// at the origin for an empty scene.
+    pub fn bounding_sphere(&self) -> (glam::Vec3, f32) {
+        let mut lo = glam::Vec3::splat(f32::INFINITY);
+        let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
+        for r in &self.regions {
+            if let Some(v) = self.volumes.get(r.volume) {
+                let (a, b) = v.grid.world_bounds();
+                lo = lo.min(a);
+                hi = hi.max(b);
+            }
+        }
+        if !lo.is_finite() || !hi.is_finite() {
+            return (glam::Vec3::ZERO, 1.0);
+        }
+        ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-3))
+    }
+}

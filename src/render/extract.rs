@@ -19,6 +19,8 @@ pub struct VolumeView {
     pub skip_empty: bool,
     /// Stop rays once they are opaque.
     pub early_termination: bool,
+    /// Show ray directions instead of the volumes (tests of ray generation).
+    pub debug_rays: bool,
     /// Seed of the jitter pattern.
     pub frame: u32,
     /// Light of the view (copied from the scene each frame).
@@ -27,7 +29,7 @@ pub struct VolumeView {
 
 impl Default for VolumeView {
     fn default() -> Self {
-        Self { jitter: true, skip_empty: true, early_termination: true, frame: 0, light: Light::Headlight }
+        Self { jitter: true, skip_empty: true, early_termination: true, debug_rays: false, frame: 0, light: Light::Headlight }
     }
 }
 
@@ -36,11 +38,11 @@ impl SyncComponent for VolumeView {
 }
 
 impl ExtractComponent for VolumeView {
-    type QueryData = &'static VolumeView;
+    type QueryData = (&'static VolumeView, Option<&'static crate::lens::ViewLenses>);
     type QueryFilter = With<Camera3d>;
     type Out = GpuSettings;
 
-    fn extract_component(v: &VolumeView) -> Option<GpuSettings> {
+    fn extract_component((v, lenses): (&VolumeView, Option<&crate::lens::ViewLenses>)) -> Option<GpuSettings> {
         let mut flags = 0;
         if v.jitter {
             flags |= view_flags::JITTER;
@@ -51,11 +53,18 @@ impl ExtractComponent for VolumeView {
         if v.early_termination {
             flags |= view_flags::EARLY_TERMINATION;
         }
+        if v.debug_rays {
+            flags |= view_flags::DEBUG_RAYS;
+        }
         let light = match v.light {
             Light::Headlight => Vec4::ZERO,
             Light::Direction(d) => d.normalize_or_zero().extend(1.0),
         };
-        Some(GpuSettings { light, flags, frame: v.frame, pad: 0 })
+        let mut settings = GpuSettings { light, flags, frame: v.frame, ..Default::default() };
+        if let Some(lenses) = lenses {
+            super::lens_pack::pack_lenses(&mut settings, &lenses.lenses);
+        }
+        Some(settings)
     }
 }
 

@@ -34,9 +34,11 @@ pub mod features {
     pub const ISO: u32 = 16;
     pub const SHADING: u32 = 32;
     pub const MULTI_REGION: u32 = 64;
+    /// The view has lenses (a per-view feature).
+    pub const LENSES: u32 = 128;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 7] = [
+    pub const NAMES: [(u32, &str); 8] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -44,6 +46,7 @@ pub mod features {
         (ISO, "HAS_ISO"),
         (SHADING, "HAS_SHADING"),
         (MULTI_REGION, "MULTI_REGION"),
+        (LENSES, "HAS_LENSES"),
     ];
 }
 
@@ -52,6 +55,8 @@ pub mod view_flags {
     pub const JITTER: u32 = 1;
     pub const SKIP_EMPTY: u32 = 2;
     pub const EARLY_TERMINATION: u32 = 4;
+    /// Output each pixel's ray direction as colour, `dir·½ + ½` (tests of ray generation).
+    pub const DEBUG_RAYS: u32 = 8;
 }
 
 /// One region, with everything the shader needs about its volume and appearance.
@@ -90,14 +95,57 @@ pub struct GpuRegion {
     pub pad_c: f32,
 }
 
+/// Lens kinds, shapes (codes shared with `shaders/focal/lens.wgsl`).
+pub mod lens_codes {
+    pub const MAGNIFIER: u32 = 0;
+    pub const SAMPLING: u32 = 1;
+    pub const ANGULAR: u32 = 2;
+    pub const CIRCLE: u32 = 0;
+    pub const SQUARE: u32 = 1;
+    pub const POLYGON: u32 = 2;
+    /// `vec4`s of table or outline data per lens.
+    pub const DATA_PER_LENS: usize = 16;
+}
+
+/// One lens of a view.
+#[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
+pub struct GpuLens {
+    /// kind, shape, border profile, outline vertex count.
+    pub codes: UVec4,
+    /// centre (xy, lens units), focus radius, border width.
+    pub geometry: Vec4,
+    /// Magnifier: lens plane distance, κ, magnification. Angular: half field of view,
+    /// whole view (1/0).
+    pub params: Vec4,
+}
+
 /// Per-view settings.
-#[derive(Component, Clone, Copy, Debug, Default, PartialEq, ShaderType)]
+#[derive(Component, Clone, Copy, Debug, PartialEq, ShaderType)]
 pub struct GpuSettings {
     /// Light direction towards the light (xyz), w = 1 for a fixed light, 0 for headlight.
     pub light: Vec4,
     pub flags: u32,
     pub frame: u32,
+    pub lens_count: u32,
     pub pad: u32,
+    pub lenses: [GpuLens; crate::lens::MAX_LENSES],
+    /// Outline vertices (two per vec4) or sampling tables (four values per vec4),
+    /// `DATA_PER_LENS` per lens.
+    pub lens_data: [Vec4; crate::lens::MAX_LENSES * lens_codes::DATA_PER_LENS],
+}
+
+impl Default for GpuSettings {
+    fn default() -> Self {
+        GpuSettings {
+            light: Vec4::ZERO,
+            flags: 0,
+            frame: 0,
+            lens_count: 0,
+            pad: 0,
+            lenses: [GpuLens::default(); crate::lens::MAX_LENSES],
+            lens_data: [Vec4::ZERO; crate::lens::MAX_LENSES * lens_codes::DATA_PER_LENS],
+        }
+    }
 }
 
 /// Per-scene facts.

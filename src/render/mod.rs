@@ -17,6 +17,7 @@
 pub mod extract;
 pub mod gpu_types;
 pub mod headless;
+pub mod lens_pack;
 pub mod pack;
 pub mod pass;
 pub mod pipeline;

@@ -95,10 +95,12 @@ pub fn prepare_pipelines(
     mut pipelines: ResMut<SpecializedRenderPipelines<RaycastPipeline>>,
     pipeline: Res<RaycastPipeline>,
     scene: Res<super::upload::GpuScene>,
-    views: Query<(Entity, &ViewTarget), (With<ExtractedView>, With<GpuSettings>)>,
+    views: Query<(Entity, &ViewTarget, &GpuSettings), With<ExtractedView>>,
 ) {
-    for (entity, target) in &views {
-        let id = pipelines.specialize(&cache, &pipeline, RaycastKey { format: target.main_texture_format(), features: scene.features });
+    for (entity, target, settings) in &views {
+        let lenses = if settings.lens_count > 0 { features::LENSES } else { 0 };
+        let key = RaycastKey { format: target.main_texture_format(), features: scene.features | lenses };
+        let id = pipelines.specialize(&cache, &pipeline, key);
         commands.entity(entity).insert(RaycastPipelineId(id));
     }
 }

@@ -10,7 +10,7 @@ use bevy::shader::Shader;
 pub const RAYCAST: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a11");
 
 /// (fixed handle, file name, source) of every shader.
-const SHADERS: [(Handle<Shader>, &str, &str); 9] = [
+const SHADERS: [(Handle<Shader>, &str, &str); 10] = [
     (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a01"), "shaders/focal/types.wgsl", include_str!("../../shaders/focal/types.wgsl")),
     (
         uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a02"),
@@ -35,6 +35,7 @@ const SHADERS: [(Handle<Shader>, &str, &str); 9] = [
         "shaders/focal/compositing.wgsl",
         include_str!("../../shaders/focal/compositing.wgsl"),
     ),
+    (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a09"), "shaders/focal/lens.wgsl", include_str!("../../shaders/focal/lens.wgsl")),
     (RAYCAST, "shaders/raycast.wgsl", include_str!("../../shaders/raycast.wgsl")),
 ];
 

@@ -66,6 +66,9 @@ pub struct SceneFile {
     pub datasets: Vec<DatasetSpec>,
     #[serde(default)]
     pub camera: CameraSpec,
+    /// Magic lenses on the view, in order (the last on top).
+    #[serde(default)]
+    pub lenses: Vec<crate::lens::Lens>,
     /// Frames to capture; none means one frame of the scene as it is.
     #[serde(default)]
     pub frames: Vec<FrameSpec>,
@@ -260,22 +263,62 @@ pub struct FrameSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Change {
-    Mode { dataset: usize, mode: Mode },
-    Preset { dataset: usize, preset: String },
-    Transfer { dataset: usize, transfer: TransferFunction },
-    Step { dataset: usize, step: f32 },
-    Iso { dataset: usize, value: f64 },
-    Shading { dataset: usize, enabled: bool },
-    Visible { dataset: usize, visible: bool },
-    LabelOpacity { dataset: usize, label: u32, opacity: f32 },
+    Mode {
+        dataset: usize,
+        mode: Mode,
+    },
+    Preset {
+        dataset: usize,
+        preset: String,
+    },
+    Transfer {
+        dataset: usize,
+        transfer: TransferFunction,
+    },
+    Step {
+        dataset: usize,
+        step: f32,
+    },
+    Iso {
+        dataset: usize,
+        value: f64,
+    },
+    Shading {
+        dataset: usize,
+        enabled: bool,
+    },
+    Visible {
+        dataset: usize,
+        visible: bool,
+    },
+    LabelOpacity {
+        dataset: usize,
+        label: u32,
+        opacity: f32,
+    },
     Background((f32, f32, f32)),
     Light(Light),
+    /// Replaces the view's lenses.
+    Lenses(Vec<crate::lens::Lens>),
 }
 
 impl SceneFile {
     /// Parses RON text; `origin` names it in errors (with line and column).
     pub fn parse(text: &str, origin: &str) -> Result<SceneFile, String> {
         ron::from_str(text).map_err(|e| format!("{origin}: {e}"))
+    }
+
+    /// Checks what parsing cannot: the lenses' parameters.
+    pub fn validate(&self) -> Result<(), String> {
+        validate_lenses(&self.lenses)?;
+        for frame in &self.frames {
+            for change in &frame.set {
+                if let Change::Lenses(lenses) = change {
+                    validate_lenses(lenses).map_err(|e| format!("frame '{}': {e}", frame.name))?;
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Writes RON text.
@@ -286,6 +329,17 @@ impl SceneFile {
     pub fn background(&self) -> [f32; 3] {
         [self.background.0, self.background.1, self.background.2]
     }
+}
+
+/// Checks lenses; the message names the lens by its place in the list.
+pub fn validate_lenses(lenses: &[crate::lens::Lens]) -> Result<(), String> {
+    if lenses.len() > crate::lens::MAX_LENSES {
+        return Err(format!("{} lenses, at most {} are supported per view", lenses.len(), crate::lens::MAX_LENSES));
+    }
+    for (i, l) in lenses.iter().enumerate() {
+        l.validate().map_err(|e| format!("lens {i} ({}): {e}", l.kind_name()))?;
+    }
+    Ok(())
 }
 
 /// A tuple as a vector.

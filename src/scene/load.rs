@@ -33,7 +33,9 @@ pub fn resolve(base: &Path, p: &Path) -> PathBuf {
 /// Reads a scene file.
 pub fn read_scene(path: &Path) -> Result<SceneFile, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    SceneFile::parse(&text, &path.display().to_string())
+    let scene = SceneFile::parse(&text, &path.display().to_string())?;
+    scene.validate().map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(scene)
 }
 
 /// Loads every dataset of `scene`; relative paths start at `base`.
@@ -225,6 +227,7 @@ pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneF
         },
         Change::Background(c) => scene.background = *c,
         Change::Light(l) => scene.light = *l,
+        Change::Lenses(l) => scene.lenses = l.clone(),
     }
     Ok(())
 }

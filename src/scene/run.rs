@@ -11,7 +11,8 @@ use super::file::{FrameSpec, SceneFile};
 use super::load::{LoadedDataset, apply, camera, load_datasets, read_scene, render_scene, visible_bounds};
 use crate::FocalPlugins;
 use crate::dataset::{Dataset, SceneLight};
-use crate::reference::render;
+use crate::lens::systems::LensOrder;
+use crate::reference::render_lensed;
 use crate::render::VolumeView;
 use crate::render::headless::Offscreen;
 
@@ -73,7 +74,7 @@ pub fn render_frames(mut scene: SceneFile, base: &Path, options: &RunOptions) ->
         let cam = camera(&camera_spec, bounds, w as f32 / h as f32);
         let image = match &mut gpu {
             Some(g) => g.capture(&datasets, &scene, &cam)?,
-            None => render(&render_scene(&datasets, &scene), &cam, w, h)?.to_image()?,
+            None => render_lensed(&render_scene(&datasets, &scene), &cam, &scene.lenses, w, h)?.to_image()?,
         };
         images.push((frame.name.clone(), image));
     }
@@ -84,6 +85,7 @@ pub fn render_frames(mut scene: SceneFile, base: &Path, options: &RunOptions) ->
 struct GpuRun {
     off: Offscreen,
     entities: Vec<Entity>,
+    lenses: Vec<Entity>,
 }
 
 impl GpuRun {
@@ -92,7 +94,7 @@ impl GpuRun {
             app.add_plugins(FocalPlugins);
         })?;
         let entities = datasets.iter().map(|d| off.world_mut().spawn((dataset_component(d), transform(d))).id()).collect();
-        Ok(GpuRun { off, entities })
+        Ok(GpuRun { off, entities, lenses: Vec::new() })
     }
 
     fn capture(&mut self, datasets: &[LoadedDataset], scene: &SceneFile, cam: &crate::region::Camera) -> Result<image::RgbaImage, String> {
@@ -100,6 +102,12 @@ impl GpuRun {
             self.off.world_mut().entity_mut(*e).insert((dataset_component(d), transform(d)));
         }
         self.off.world_mut().insert_resource(SceneLight(scene.light));
+        for e in self.lenses.drain(..) {
+            self.off.world_mut().despawn(e);
+        }
+        for (i, lens) in scene.lenses.iter().enumerate() {
+            self.lenses.push(self.off.world_mut().spawn((lens.clone(), LensOrder(i as u32))).id());
+        }
         let r = scene.rendering;
         self.off.set_view(VolumeView {
             jitter: r.jitter,

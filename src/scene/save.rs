@@ -99,6 +99,7 @@ pub fn scene_file(
         rendering: Default::default(),
         datasets,
         camera,
+        lenses: Vec::new(),
         frames: Vec::new(),
     }
 }

@@ -1,0 +1,195 @@
+#define_import_path focal::lens
+
+// Ray generation under the view's lenses (reference: src/lens/stack.rs, which holds the
+// algorithm and the paper's equations; keep the two in step). Lens coordinates:
+// s = (x·aspect, y) in normalised device coordinates, one unit = half the view height.
+
+#import focal::types::{Lens, LENS_DATA}
+#import focal::bindings::{view, settings}
+#import focal::camera::{Ray, pixel_ray}
+
+const LENS_MAGNIFIER: u32 = 0u;
+const LENS_SAMPLING: u32 = 1u;
+const LENS_ANGULAR: u32 = 2u;
+const SHAPE_SQUARE: u32 = 1u;
+const SHAPE_POLYGON: u32 = 2u;
+const PROFILE_SIMPLE: u32 = 0u;
+const PROFILE_LINEAR: u32 = 1u;
+const SAMPLING_TABLE: u32 = 64u;
+
+fn view_aspect() -> f32 {
+    return view.viewport.z / view.viewport.w;
+}
+
+fn to_lens(uv: vec2<f32>) -> vec2<f32> {
+    return vec2((uv.x * 2.0 - 1.0) * view_aspect(), 1.0 - uv.y * 2.0);
+}
+
+fn lens_uv(s: vec2<f32>) -> vec2<f32> {
+    return vec2((s.x / view_aspect() + 1.0) * 0.5, (1.0 - s.y) * 0.5);
+}
+
+fn is_perspective() -> bool {
+    return view.clip_from_view[3][3] < 0.5;
+}
+
+// The camera's own ray through uv, from the eye for a perspective view (as the CPU
+// camera), from the camera plane for an orthographic one.
+fn camera_ray(uv: vec2<f32>) -> Ray {
+    let r = pixel_ray(uv);
+    if is_perspective() {
+        return Ray(view.world_position, r.dir);
+    }
+    return r;
+}
+
+fn outline_vertex(base: u32, i: u32) -> vec2<f32> {
+    let v = settings.lens_data[base + i / 2u];
+    if (i & 1u) == 0u {
+        return v.xy;
+    }
+    return v.zw;
+}
+
+// Signed distance to the drawn outline (negative inside, even-odd rule).
+fn outline_distance(base: u32, n: u32, p: vec2<f32>) -> f32 {
+    var d2 = 3.4e38;
+    var inside = false;
+    for (var i = 0u; i < n; i++) {
+        let a = outline_vertex(base, i);
+        let b = outline_vertex(base, (i + 1u) % n);
+        let e = b - a;
+        let t = clamp(dot(p - a, e) / max(dot(e, e), 1e-12), 0.0, 1.0);
+        let q = p - a - e * t;
+        d2 = min(d2, dot(q, q));
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    if inside {
+        return -sqrt(d2);
+    }
+    return sqrt(d2);
+}
+
+fn radial(lens: Lens, base: u32, v: vec2<f32>) -> f32 {
+    if lens.codes.y == SHAPE_SQUARE {
+        return max(abs(v.x), abs(v.y));
+    }
+    if lens.codes.y == SHAPE_POLYGON {
+        return lens.geometry.z + outline_distance(base, lens.codes.w, v);
+    }
+    return length(v);
+}
+
+// LaMar's source radius rho(r) and the magnifier's blend weight (profile.rs).
+fn source_radius(profile: u32, r: f32, lr: f32, lb: f32, m: f32) -> f32 {
+    if r <= lr {
+        return r / m;
+    }
+    if profile == PROFILE_SIMPLE || lb <= 0.0 || r >= lr + lb {
+        return r;
+    }
+    let p0 = lr / m;
+    let p3 = lr + lb;
+    let u = (r - lr) / lb;
+    if profile == PROFILE_LINEAR {
+        return p0 + (p3 - p0) * u;
+    }
+    let p1 = p0 + lb / (3.0 * m);
+    let p2 = p3 - lb / 3.0;
+    let w = 1.0 - u;
+    return w * w * w * p0 + 3.0 * w * w * u * p1 + 3.0 * w * u * u * p2 + u * u * u * p3;
+}
+
+fn blend_weight(profile: u32, r: f32, lr: f32, lb: f32, m: f32) -> f32 {
+    if r <= lr {
+        return 0.0;
+    }
+    if abs(m - 1.0) < 1e-6 {
+        return 1.0;
+    }
+    let inv = 1.0 / m;
+    return clamp((source_radius(profile, r, lr, lb, m) / r - inv) / (1.0 - inv), 0.0, 1.0);
+}
+
+// Magnifier (magnifier.rs, Wang et al. eq. 1-3).
+fn bend(lens: Lens, central: Ray, below: Ray, r: f32) -> Ray {
+    let c = central.dir;
+    let p_o = central.origin + c * lens.params.x;
+    let along = dot(below.dir, c);
+    if along <= 1e-6 {
+        return below;
+    }
+    let p = below.origin + below.dir * (dot(p_o - below.origin, c) / along);
+    let focused = c + (p_o - p) * lens.params.y;
+    let normal = below.dir / along;
+    let w = blend_weight(lens.codes.z, r, lens.geometry.z, lens.geometry.w, lens.params.z);
+    let dir = normalize(focused * (1.0 - w) + normal * w);
+    let back = dot(central.origin - p, c) / dot(dir, c);
+    if back > 0.0 {
+        return Ray(p + dir * back, dir);
+    }
+    return Ray(p, dir);
+}
+
+fn sampling_source(base: u32, r: f32) -> f32 {
+    let x = clamp(r, 0.0, 1.0) * f32(SAMPLING_TABLE - 1u);
+    let i = min(u32(floor(x)), SAMPLING_TABLE - 2u);
+    let f = x - f32(i);
+    let a = settings.lens_data[base + i / 4u][i % 4u];
+    let b = settings.lens_data[base + (i + 1u) / 4u][(i + 1u) % 4u];
+    return a * (1.0 - f) + b * f;
+}
+
+// Angular fisheye (angular.rs).
+fn fisheye(central: Ray, v: vec2<f32>, lr: f32, half_angle: f32) -> Ray {
+    let r = length(v);
+    if r <= 1e-9 {
+        return central;
+    }
+    let theta = r / lr * half_angle;
+    let side = view.world_from_view[0].xyz * (v.x / r) + view.world_from_view[1].xyz * (v.y / r);
+    let u = side - central.dir * dot(side, central.dir);
+    let ul = length(u);
+    var un = vec3(0.0);
+    if ul > 0.0 {
+        un = u / ul;
+    }
+    return Ray(central.origin, normalize(central.dir * cos(theta) + un * sin(theta)));
+}
+
+// The ray of a pixel under the view's lenses; a zero direction means no ray.
+fn lens_ray(uv: vec2<f32>) -> Ray {
+    let s = to_lens(uv);
+    var ray = camera_ray(uv);
+    for (var i = 0u; i < settings.lens_count; i++) {
+        let lens = settings.lenses[i];
+        let base = i * LENS_DATA;
+        let centre = lens.geometry.xy;
+        let lr = lens.geometry.z;
+        let v = s - centre;
+        let r = radial(lens, base, v);
+        if lens.codes.x == LENS_MAGNIFIER {
+            var reach = lr + lens.geometry.w;
+            if lens.codes.z == PROFILE_SIMPLE {
+                reach = lr;
+            }
+            if r < reach {
+                ray = bend(lens, camera_ray(lens_uv(centre)), ray, r);
+            }
+        } else if lens.codes.x == LENS_SAMPLING {
+            if r < lr && r > 0.0 {
+                let rho = sampling_source(base, r / lr) * lr;
+                ray = camera_ray(lens_uv(centre + v * (rho / r)));
+            }
+        } else {
+            if r < lr {
+                ray = fisheye(camera_ray(lens_uv(centre)), v, lr, lens.params.x);
+            } else if lens.params.y > 0.5 {
+                return Ray(ray.origin, vec3(0.0));
+            }
+        }
+    }
+    return ray;
+}

@@ -1,0 +1,87 @@
+//! Lens systems: each frame, the lenses of the world resolved for every volume camera.
+
+use bevy::camera::CameraUpdateSystems;
+use bevy::prelude::*;
+
+use super::spec::Lens;
+use super::stack::{MAX_LENSES, ResolvedLens, Screen, resolve};
+use crate::dataset::SceneRegions;
+use crate::region::{Camera as FocalCamera, Projection as FocalProjection};
+use crate::render::VolumeView;
+
+/// The lenses of one view, resolved for its camera this frame (in lens order).
+#[derive(Component, Clone, Debug, Default, PartialEq)]
+pub struct ViewLenses {
+    pub lenses: Vec<ResolvedLens>,
+    pub camera: Option<FocalCamera>,
+    pub screen: Option<Screen>,
+}
+
+/// The Focal camera of a Bevy camera (`None` for custom projections).
+pub fn focal_camera(transform: &GlobalTransform, projection: &Projection) -> Option<FocalCamera> {
+    let projection = match projection {
+        Projection::Perspective(p) => FocalProjection::Perspective { fov_y: p.fov },
+        Projection::Orthographic(o) => {
+            let height = match o.scaling_mode {
+                _ if o.area.height() > 0.0 => o.area.height(),
+                bevy::camera::ScalingMode::FixedVertical { viewport_height } => viewport_height * o.scale,
+                _ => return None,
+            };
+            FocalProjection::Orthographic { height }
+        }
+        _ => return None,
+    };
+    let (_, rotation, position) = transform.to_scale_rotation_translation();
+    Some(FocalCamera { position, rotation, projection })
+}
+
+/// Place of a lens in the stack (lower first, the last on top); lenses without it
+/// follow in entity order.
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct LensOrder(pub u32);
+
+pub fn resolve_view_lenses(
+    lenses: Query<(Entity, &Lens, Option<&LensOrder>)>,
+    mut views: Query<(&Camera, &GlobalTransform, &Projection, &mut ViewLenses), With<VolumeView>>,
+    scene: Res<SceneRegions>,
+) {
+    let mut ordered: Vec<(Entity, &Lens, Option<&LensOrder>)> =
+        lenses.iter().filter(|(_, l, _)| l.enabled && l.validate().is_ok()).collect();
+    ordered.sort_by_key(|(e, _, o)| (o.map_or(u32::MAX, |o| o.0), *e));
+    ordered.truncate(MAX_LENSES);
+    let bounds = scene.scene.bounding_sphere();
+    for (camera, transform, projection, mut view) in &mut views {
+        let (Some(cam), Some(size)) = (focal_camera(transform, projection), camera.physical_viewport_size()) else {
+            continue;
+        };
+        let screen = Screen::new(size.x, size.y);
+        let resolved: Vec<ResolvedLens> = ordered.iter().map(|(_, l, _)| resolve(l, &cam, screen, bounds)).collect();
+        let next = ViewLenses { lenses: resolved, camera: Some(cam), screen: Some(screen) };
+        if *view != next {
+            *view = next;
+        }
+    }
+}
+
+/// Adds [`ViewLenses`] to every volume camera.
+fn add_view_lenses(mut commands: Commands, views: Query<Entity, (With<VolumeView>, Without<ViewLenses>)>) {
+    for e in &views {
+        commands.entity(e).insert(ViewLenses::default());
+    }
+}
+
+/// Lens resolution (no GPU needed).
+pub struct LensPlugin;
+
+impl Plugin for LensPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(
+            PostUpdate,
+            (add_view_lenses, resolve_view_lenses)
+                .chain()
+                .after(TransformSystems::Propagate)
+                .after(CameraUpdateSystems)
+                .after(crate::dataset::RegionSystems::Modify),
+        );
+    }
+}

@@ -1,0 +1,192 @@
+//! GPU image tests of the magic lenses: every lens kind against the CPU reference, the
+//! GPU's ray directions against the CPU's, a magnified sphere's area, and the image
+//! outside a lens.
+
+use super::*;
+use focal::lens::{Lens, LensKind, Profile, Sampling, Screen, Shape, lens_ray, systems::LensOrder};
+use focal::reference::render_lensed;
+use focal::transfer::color::srgb_to_linear;
+
+fn set_lenses(gpu: &mut Gpu, lenses: &[Lens]) {
+    let world = gpu.off.world_mut();
+    let old: Vec<Entity> = world.query_filtered::<Entity, With<Lens>>().iter(world).collect();
+    for e in old {
+        world.despawn(e);
+    }
+    for (i, l) in lenses.iter().enumerate() {
+        world.spawn((l.clone(), LensOrder(i as u32)));
+    }
+}
+
+fn show_lensed(gpu: &mut Gpu, volume: Arc<Volume>, appearance: Appearance, camera: &FocalCamera, lenses: &[Lens]) -> image::RgbaImage {
+    set_lenses(gpu, lenses);
+    let img = gpu.show(volume, appearance, camera);
+    set_lenses(gpu, &[]);
+    img
+}
+
+fn cpu_lensed(volume: Arc<Volume>, appearance: Appearance, camera: &FocalCamera, lenses: &[Lens]) -> image::RgbaImage {
+    render_lensed(&RenderScene::single(volume, appearance), camera, lenses, SIZE, SIZE).unwrap().to_image().unwrap()
+}
+
+fn magnifier(profile: Profile, shape: Shape, m: f32) -> Lens {
+    let mut l = Lens::magnifier(Vec2::new(0.1, -0.05), 0.35, 0.25, m);
+    l.kind = LensKind::Magnifier { magnification: m, profile, focus_depth: None, plane_depth: None };
+    l.shape = shape;
+    l
+}
+
+fn all_kinds() -> Vec<(&'static str, Vec<Lens>)> {
+    let star: Vec<Vec2> = (0..10)
+        .map(|i| {
+            let a = i as f32 * std::f32::consts::PI / 5.0;
+            let r = if i % 2 == 0 { 0.45 } else { 0.2 };
+            Vec2::new(a.cos(), a.sin()) * r
+        })
+        .collect();
+    vec![
+        ("circle_cubic", vec![magnifier(Profile::Cubic, Shape::Circle, 2.5)]),
+        ("square_linear", vec![magnifier(Profile::Linear, Shape::Square, 2.0)]),
+        ("drawn_simple", vec![magnifier(Profile::Simple, Shape::Polygon(star), 2.0)]),
+        (
+            "sampling_cubic",
+            vec![Lens { kind: LensKind::Sampling(Sampling::Cubic { center_rate: 3.0 }), ..Lens::magnifier(Vec2::ZERO, 0.6, 0.0, 1.0) }],
+        ),
+        (
+            "sampling_drawn",
+            vec![Lens {
+                kind: LensKind::Sampling(Sampling::Custom(vec![2.0, 2.0, 0.5, 1.0])),
+                ..Lens::magnifier(Vec2::ZERO, 0.6, 0.0, 1.0)
+            }],
+        ),
+        (
+            "angular_lens",
+            vec![Lens {
+                kind: LensKind::Angular { field_of_view: 120.0, whole_view: false },
+                ..Lens::magnifier(Vec2::ZERO, 0.5, 0.0, 1.0)
+            }],
+        ),
+        ("two_lenses", vec![magnifier(Profile::Cubic, Shape::Circle, 2.0), Lens::magnifier(Vec2::new(-0.3, 0.2), 0.2, 0.1, 3.0)]),
+    ]
+}
+
+pub fn lenses_match_the_reference(gpu: &mut Gpu) {
+    let h = head();
+    let appearance = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap());
+    for ortho in [false, true] {
+        let cam = framed(&h, View::Oblique, ortho);
+        // Orthographic: two kinds (the ray directions of all are checked below).
+        for (name, lenses) in all_kinds() {
+            if ortho && !matches!(name, "circle_cubic" | "sampling_cubic") {
+                continue;
+            }
+            let name = format!("lens_{name}{}", if ortho { "_ortho" } else { "" });
+            let g = show_lensed(gpu, h.clone(), appearance.clone(), &cam, &lenses);
+            let c = cpu_lensed(h.clone(), appearance.clone(), &cam, &lenses);
+            assert_matches(&name, &g, &c);
+        }
+    }
+    // A whole-view 180° fisheye from inside the head.
+    let inside =
+        FocalCamera::look_at(Vec3::new(0.0, 10.0, 20.0), Vec3::new(0.0, 0.0, 20.0), Vec3::Z, FocalProjection::Perspective { fov_y: 1.0 });
+    let fisheye =
+        vec![Lens { kind: LensKind::Angular { field_of_view: 180.0, whole_view: true }, ..Lens::magnifier(Vec2::ZERO, 1.0, 0.0, 1.0) }];
+    let g = show_lensed(gpu, h.clone(), appearance.clone(), &inside, &fisheye);
+    let c = cpu_lensed(h.clone(), appearance, &inside, &fisheye);
+    assert_matches("lens_fisheye_inside", &g, &c);
+}
+
+pub fn ray_directions_match_the_reference(gpu: &mut Gpu) {
+    let h = head();
+    let appearance = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap());
+    gpu.off.set_view(VolumeView { jitter: false, debug_rays: true, ..Default::default() });
+    for ortho in [false, true] {
+        let cam = framed(&h, View::Left, ortho);
+        for (name, lenses) in all_kinds() {
+            set_lenses(gpu, &lenses);
+            gpu.off.world_mut().spawn((Dataset::new(h.clone(), appearance.clone()), Transform::default()));
+            gpu.off.set_camera(&cam);
+            let img = gpu.off.capture().unwrap_or_else(|e| panic!("{e}"));
+            gpu.clear();
+            gpu.off.set_view(VolumeView { jitter: false, debug_rays: true, ..Default::default() });
+            let screen = Screen::new(SIZE, SIZE);
+            let resolved: Vec<_> = lenses
+                .iter()
+                .map(|l| focal::lens::stack::resolve(l, &cam, screen, RenderScene::single(h.clone(), appearance.clone()).bounding_sphere()))
+                .collect();
+            let mut worst = 0.0f32;
+            for y in (2..SIZE).step_by(5) {
+                for x in (2..SIZE).step_by(5) {
+                    let want = lens_ray(&cam, screen, &resolved, x as f32 + 0.5, y as f32 + 0.5).unwrap().dir;
+                    let p = img.get_pixel(x, y);
+                    let got = Vec3::new(
+                        srgb_to_linear(p[0] as f32 / 255.0),
+                        srgb_to_linear(p[1] as f32 / 255.0),
+                        srgb_to_linear(p[2] as f32 / 255.0),
+                    ) * 2.0
+                        - 1.0;
+                    worst = worst.max((got - want).abs().max_element());
+                }
+            }
+            println!("    rays {name} (ortho {ortho}): largest component difference {worst:.4}");
+            assert!(worst < 0.02, "{name}: GPU ray directions differ from the CPU's by {worst}");
+        }
+    }
+    set_lenses(gpu, &[]);
+    gpu.clear();
+}
+
+fn covered(img: &image::RgbaImage) -> usize {
+    img.pixels().filter(|p| p[0] > 20 || p[1] > 20 || p[2] > 20).count()
+}
+
+pub fn magnifier_scales_a_sphere_by_m_squared(gpu: &mut Gpu) {
+    let sphere = Arc::new(phantom::sphere(48, 16.0).unwrap());
+    let mut appearance = Appearance { iso_value: 127.5, ..Appearance::new(Mode::Iso, opaque_ramp()) };
+    appearance.shading.enabled = false;
+    for ortho in [false, true] {
+        let (lo, hi) = sphere.grid.world_bounds();
+        let centre = (lo + hi) * 0.5;
+        let cam = View::Anterior.frame(centre, (hi - lo).length(), ortho);
+        let plain = gpu.show(sphere.clone(), appearance.clone(), &cam);
+        for m in [1.5f32, 2.0] {
+            let lens = Lens {
+                kind: LensKind::Magnifier { magnification: m, profile: Profile::Cubic, focus_depth: None, plane_depth: None },
+                ..Lens::magnifier(Vec2::ZERO, 0.6, 0.2, m)
+            };
+            let img = show_lensed(gpu, sphere.clone(), appearance.clone(), &cam, &[lens]);
+            let ratio = covered(&img) as f32 / covered(&plain) as f32;
+            println!(
+                "    sphere ×{m} (ortho {ortho}): {} → {} pixels, ratio {ratio:.2} (m² = {:.2})",
+                covered(&plain),
+                covered(&img),
+                m * m
+            );
+            assert!((ratio / (m * m) - 1.0).abs() < 0.12, "area ratio {ratio} for m = {m}");
+        }
+    }
+}
+
+pub fn outside_the_lens_the_image_is_unchanged(gpu: &mut Gpu) {
+    let h = head();
+    let appearance = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap());
+    let cam = framed(&h, View::Anterior, false);
+    let plain = gpu.show(h.clone(), appearance.clone(), &cam);
+    let lens = magnifier(Profile::Cubic, Shape::Circle, 3.0);
+    let img = show_lensed(gpu, h.clone(), appearance, &cam, std::slice::from_ref(&lens));
+    let screen = Screen::new(SIZE, SIZE);
+    let (mut outside, mut worst, mut changed_inside) = (0, 0u8, 0);
+    for (x, y, p) in img.enumerate_pixels() {
+        let s = screen.to_lens(x as f32 + 0.5, y as f32 + 0.5);
+        let d = (0..3).map(|c| p[c].abs_diff(plain.get_pixel(x, y)[c])).max().unwrap_or(0);
+        if (s - lens.center).length() > lens.radius + lens.border + 0.05 {
+            outside += 1;
+            worst = worst.max(d);
+        } else if d > 10 {
+            changed_inside += 1;
+        }
+    }
+    println!("    outside the lens: {outside} pixels, largest difference {worst} levels; {changed_inside} pixels changed inside");
+    assert!(worst <= 2, "the lens changed the image outside itself by {worst} levels");
+    assert!(changed_inside > 100, "the lens changed only {changed_inside} pixels");
+}
