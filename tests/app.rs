@@ -98,3 +98,44 @@ fn the_app_opens_a_window_and_shows_the_phantom() {
     let warm = img.pixels().filter(|p| p[0] > 150 && p[0] as u32 > p[2] as u32 + 20).count();
     assert!(warm > 2000, "only {warm} phantom-coloured pixels");
 }
+
+fn lenses(world: &mut World) -> Vec<(u32, focal::lens::Lens)> {
+    let mut v: Vec<_> =
+        world.query::<(&focal::lens::Lens, &focal::lens::systems::LensOrder)>().iter(world).map(|(l, o)| (o.0, l.clone())).collect();
+    v.sort_by_key(|(o, _)| *o);
+    v
+}
+
+#[test]
+fn scenes_bring_their_lenses_and_data_files_keep_them() {
+    let dir = scratch("app-lenses");
+    let scene = dir.join("lensed.ron");
+    std::fs::write(
+        &scene,
+        "(datasets: [(source: Phantom(kind: sphere, resolution: 16))],
+          lenses: [(kind: magnifier(magnification: 3.0), center: (0.1, 0.0)), (kind: angular(field_of_view: 120.0), radius: 0.2)])",
+    )
+    .unwrap();
+    let mut app = headless_app();
+    app.world_mut().write_message(LoadRequest::Path(scene.clone()));
+    run_until(&mut app, |w| !lenses(w).is_empty());
+    let loaded = lenses(app.world_mut());
+    assert_eq!(loaded.len(), 2);
+    assert_eq!(loaded[0].1.kind_name(), "magnifier");
+    assert_eq!(loaded[1].1.kind_name(), "angular");
+    assert_eq!(loaded[0].1.center, Vec2::new(0.1, 0.0));
+
+    // A data file keeps the lenses the user placed.
+    app.world_mut().write_message(LoadRequest::Path(data("ct/fuel.nii.gz")));
+    run_until(&mut app, |w| dataset_names(w) == vec!["fuel"]);
+    app.update();
+    assert_eq!(lenses(app.world_mut()).len(), 2);
+
+    // A scene without lenses clears them.
+    let plain = dir.join("plain.ron");
+    std::fs::write(&plain, "(datasets: [(source: Phantom(kind: sphere, resolution: 16))])").unwrap();
+    app.world_mut().write_message(LoadRequest::Path(plain));
+    run_until(&mut app, |w| dataset_names(w) != vec!["fuel"]);
+    app.update();
+    assert!(lenses(app.world_mut()).is_empty());
+}

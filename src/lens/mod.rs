@@ -12,9 +12,13 @@
 //! - [`profile`]: simple, linear and cubic borders (LaMar et al.);
 //! - [`shape`]: circle, square and drawn outlines with their distance fields;
 //! - [`sampling`]: the sampling-rate lens (§3.3, eq. 5–7);
-//! - [`angular`]: the angular fisheye (§3.4).
+//! - [`angular`]: the angular fisheye (§3.4);
+//! - [`handles`]: grabbing, dragging and drawing lenses in the viewport;
+//! - [`lattice`]: the lens-distorted lattice overlay.
 
 pub mod angular;
+pub mod handles;
+pub mod lattice;
 pub mod magnifier;
 pub mod profile;
 pub mod sampling;

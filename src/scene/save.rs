@@ -1,6 +1,6 @@
 //! Writing the current state as a scene file: every dataset with its source and its
 //! appearance spelled out (transfer functions inline, label styles as overrides), the
-//! camera as an explicit pose.
+//! camera as an explicit pose, the lenses in stack order.
 
 use std::path::Path;
 
@@ -62,6 +62,7 @@ pub fn scene_file(
     background: [f32; 3],
     light: Light,
     size: (u32, u32),
+    lenses: &[crate::lens::Lens],
     base: &Path,
 ) -> SceneFile {
     let datasets = datasets
@@ -99,7 +100,7 @@ pub fn scene_file(
         rendering: Default::default(),
         datasets,
         camera,
-        lenses: Vec::new(),
+        lenses: lenses.to_vec(),
         frames: Vec::new(),
     }
 }
@@ -129,7 +130,15 @@ mod tests {
             })
             .collect();
         let cam = View::Left.frame(Vec3::ZERO, 20.0, true);
-        let saved = scene_file(&states, &cam, [0.1, 0.2, 0.3], Light::Headlight, (64, 64), Path::new("."));
+        let lenses = vec![
+            crate::lens::Lens::magnifier(glam::Vec2::new(0.1, -0.2), 0.3, 0.1, 2.5),
+            crate::lens::Lens {
+                kind: crate::lens::LensKind::Sampling(crate::lens::Sampling::Custom(vec![2.0, 1.5, 0.5, 1.0])),
+                shape: crate::lens::Shape::Square,
+                ..crate::lens::Lens::magnifier(glam::Vec2::ZERO, 0.4, 0.0, 1.0)
+            },
+        ];
+        let saved = scene_file(&states, &cam, [0.1, 0.2, 0.3], Light::Headlight, (64, 64), &lenses, Path::new("."));
         let text = saved.to_ron().unwrap();
         let again = SceneFile::parse(&text, "saved").unwrap();
         let reloaded = load_datasets(&again, Path::new(".")).unwrap();
@@ -140,5 +149,6 @@ mod tests {
         let back = camera_of(&again.camera, (Vec3::splat(-1.0), Vec3::ONE), 1.0);
         assert!((back.position - cam.position).length() < 1e-3);
         assert_eq!(back.projection, cam.projection);
+        assert_eq!(again.lenses, lenses);
     }
 }

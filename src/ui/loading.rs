@@ -3,7 +3,8 @@
 //! A load runs on the async compute pool and reports bytes read through a
 //! [`Progress`]; the app shows a progress bar meanwhile. When it succeeds the current
 //! datasets are replaced; when it fails the error is kept for the app to show and the
-//! current data stays. Works without a window (see `tests/app.rs`).
+//! current data stays. A scene brings its lenses (replacing the current ones); a data
+//! file keeps them. Works without a window (see `tests/app.rs`).
 
 use std::path::{Path, PathBuf};
 
@@ -13,6 +14,8 @@ use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
 
 use crate::dataset::{Dataset, SceneLight};
+use crate::lens::Lens;
+use crate::lens::systems::LensOrder;
 use crate::scene::file::{AppearanceSpec, DatasetSpec, SceneFile, SourceSpec};
 use crate::scene::load::{LoadedDataset, load_datasets_with, read_scene, visible_bounds};
 use crate::volume::readers::Progress;
@@ -30,12 +33,17 @@ pub struct Session {
     pub reframe: Option<(Vec3, Vec3)>,
 }
 
+/// What a finished load brings: the scene, the folder of its relative paths, the
+/// datasets, and whether it is a scene of its own (its lenses replace the current ones;
+/// a plain data file keeps them).
+type Loaded = (SceneFile, PathBuf, Vec<LoadedDataset>, bool);
+
 /// A load under way.
 #[derive(Component)]
 pub struct Loading {
     pub what: String,
     pub progress: Progress,
-    task: Task<Result<(SceneFile, PathBuf, Vec<LoadedDataset>), String>>,
+    task: Task<Result<Loaded, String>>,
 }
 
 /// A dataset entity made from a scene file: remembers its spec for saving.
@@ -70,25 +78,26 @@ pub fn start_loads(mut commands: Commands, mut requests: MessageReader<LoadReque
     for request in requests.read() {
         let progress = Progress::default();
         let p = progress.clone();
-        let (what, job): (String, Box<dyn FnOnce() -> Result<(SceneFile, PathBuf, Vec<LoadedDataset>), String> + Send>) =
+        let (what, job): (String, Box<dyn FnOnce() -> Result<Loaded, String> + Send>) =
             match request.clone() {
                 LoadRequest::Path(path) => (
                     path.display().to_string(),
                     Box::new(move || {
-                        let (scene, base) = if path.extension().is_some_and(|e| e == "ron") {
+                        let is_scene = path.extension().is_some_and(|e| e == "ron");
+                        let (scene, base) = if is_scene {
                             (read_scene(&path)?, path.parent().map(Path::to_path_buf).unwrap_or_default())
                         } else {
                             (scene_for_file(&path), PathBuf::new())
                         };
                         let datasets = load_datasets_with(&scene, &base, Some(p))?;
-                        Ok((scene, base, datasets))
+                        Ok((scene, base, datasets, is_scene))
                     }),
                 ),
                 LoadRequest::Scene(scene, base) => (
                     "scene".to_string(),
                     Box::new(move || {
                         let datasets = load_datasets_with(&scene, &base, Some(p))?;
-                        Ok((scene, base, datasets))
+                        Ok((scene, base, datasets, true))
                     }),
                 ),
             };
@@ -102,6 +111,7 @@ pub fn finish_loads(
     mut commands: Commands,
     mut loads: Query<(Entity, &mut Loading)>,
     old: Query<Entity, With<Dataset>>,
+    old_lenses: Query<Entity, With<Lens>>,
     mut session: ResMut<Session>,
     mut light: ResMut<SceneLight>,
 ) {
@@ -109,9 +119,17 @@ pub fn finish_loads(
         let Some(result) = check_ready(&mut load.task) else { continue };
         commands.entity(entity).despawn();
         match result {
-            Ok((scene, base, datasets)) => {
+            Ok((scene, base, datasets, is_scene)) => {
                 for e in &old {
                     commands.entity(e).despawn();
+                }
+                if is_scene {
+                    for e in &old_lenses {
+                        commands.entity(e).despawn();
+                    }
+                    for (i, lens) in scene.lenses.iter().enumerate() {
+                        commands.spawn((lens.clone(), LensOrder(i as u32), Name::new(format!("lens {}", lens.kind_name()))));
+                    }
                 }
                 for d in &datasets {
                     commands.spawn((

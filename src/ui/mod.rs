@@ -5,6 +5,7 @@
 //! command line; loading runs in the background with a progress bar and a failed load
 //! leaves the current data in place. See [`SHORTCUTS`] for the keys.
 
+pub mod lenses;
 pub mod loading;
 pub mod orbit;
 pub mod panels;
@@ -33,6 +34,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Left drag", "orbit"),
     ("Right / middle drag", "pan"),
     ("Wheel", "zoom"),
+    ("Drag a lens", "move it (its rim: radius; its dashed ring: border)"),
+    ("Wheel over a lens", "magnification (rate, field of view)"),
+    ("Delete / Esc", "remove the selected lens / stop drawing"),
+    ("V", "fly-through on / off (drag: look; arrows, Page Up / Down, wheel: move)"),
     ("Double-click", "centre on the point under the cursor"),
     ("R", "reset the camera"),
     ("1 … 6", "view from front, back, left, right, top, bottom"),
@@ -109,6 +114,7 @@ impl Plugin for FocalAppPlugin {
         app.add_plugins((EguiPlugin::default(), FrameTimeDiagnosticsPlugin::default(), LoadingPlugin))
             .insert_resource(AppState { screenshot_and_exit: self.screenshot_and_exit.clone(), ..Default::default() })
             .init_resource::<PointerInViewport>()
+            .init_resource::<lenses::LensUi>()
             .add_systems(
                 Startup,
                 move |mut commands: Commands, mut egui: ResMut<EguiGlobalSettings>, mut load: MessageWriter<LoadRequest>| {
@@ -121,7 +127,7 @@ impl Plugin for FocalAppPlugin {
             )
             .add_systems(
                 Update,
-                (orbit::orbit_input, shortcuts, dropped_files, centre_on_double_click, reframe, sync_view, automation, orbit::apply_orbit)
+                (lenses::lens_input, lenses::lens_keys, orbit::orbit_input, orbit::fly_keys, shortcuts, dropped_files, centre_on_double_click, reframe, sync_view, automation, orbit::apply_orbit)
                     .chain(),
             )
             .add_systems(EguiPrimaryContextPass, panels::ui);
@@ -238,6 +244,15 @@ fn shortcuts(
     if keys.just_pressed(KeyCode::KeyP) {
         orbit.orthographic = !orbit.orthographic;
     }
+    if keys.just_pressed(KeyCode::KeyV) {
+        toggle_fly(&mut orbit, bounds);
+    }
+}
+
+/// Turns fly-through on or off; its speed follows the scene's size.
+pub fn toggle_fly(orbit: &mut OrbitCamera, bounds: (Vec3, Vec3)) {
+    orbit.fly = !orbit.fly;
+    orbit.fly_speed = ((bounds.1 - bounds.0).length() * 0.25).max(1e-3);
 }
 
 /// Where screenshots go.
@@ -296,11 +311,7 @@ fn centre_on_double_click(
     }
     let Some(cursor) = orbit::double_click(&buttons, window, time.elapsed_secs_f64(), &mut last) else { return };
     let Ok((mut orbit, camera)) = cams.single_mut() else { return };
-    let scale = window.scale_factor();
-    let (origin, size) = match &camera.viewport {
-        Some(v) => (v.physical_position.as_vec2() / scale, v.physical_size.as_vec2() / scale),
-        None => (Vec2::ZERO, Vec2::new(window.width(), window.height())),
-    };
+    let (origin, size) = lenses::viewport_logical(camera, window);
     let p = cursor - origin;
     let ray = orbit.camera().ray(p.x, p.y, size.x.max(1.0) as u32, size.y.max(1.0) as u32);
     if let Ok(Some(hit)) = crate::reference::pick(&regions.scene, ray) {

@@ -23,11 +23,16 @@ pub struct OrbitCamera {
     pub orthographic: bool,
     /// Vertical field of view (perspective).
     pub fov_deg: f32,
+    /// Fly-through: drags turn the view about the eye, the wheel and the arrow keys move
+    /// the eye (it may enter the volume).
+    pub fly: bool,
+    /// Fly-through speed, world units per second (a quarter of the scene's diagonal).
+    pub fly_speed: f32,
 }
 
 impl Default for OrbitCamera {
     fn default() -> Self {
-        Self { target: Vec3::ZERO, azimuth_deg: 35.0, elevation_deg: 20.0, distance: 600.0, orthographic: false, fov_deg: 30.0 }
+        Self { target: Vec3::ZERO, azimuth_deg: 35.0, elevation_deg: 20.0, distance: 600.0, orthographic: false, fov_deg: 30.0, fly: false, fly_speed: 100.0 }
     }
 }
 
@@ -56,6 +61,22 @@ impl OrbitCamera {
     pub fn orbit(&mut self, delta: Vec2) {
         self.azimuth_deg = (self.azimuth_deg - delta.x * ORBIT_SPEED).rem_euclid(360.0);
         self.elevation_deg = (self.elevation_deg + delta.y * ORBIT_SPEED).clamp(-89.0, 89.0);
+    }
+
+    /// Fly-through: turns the view about the eye by a drag of `delta` pixels (the
+    /// view follows the pointer, as when turning one's head).
+    pub fn look(&mut self, delta: Vec2) {
+        let eye = self.camera().position;
+        self.orbit(delta);
+        let back = (self.camera().position - self.target).normalize_or(Vec3::Y);
+        self.target = eye - back * self.distance;
+    }
+
+    /// Fly-through: moves the eye (and the target) by `right`, `up` and `forward` world
+    /// units along the camera's axes.
+    pub fn fly_by(&mut self, right: f32, up: f32, forward: f32) {
+        let cam = self.camera();
+        self.target += cam.right() * right + cam.up() * up + cam.forward() * forward;
     }
 
     /// Moves the target so the scene follows a drag of `delta` pixels in a viewport
@@ -103,6 +124,10 @@ impl OrbitCamera {
 pub struct PointerInViewport {
     pub inside: bool,
     pub height: f32,
+    /// A lens took the button press (the drag is the lens's, not the camera's).
+    pub press_taken: bool,
+    /// A lens took the wheel this frame.
+    pub wheel_taken: bool,
 }
 
 /// Applies mouse input to the orbit camera.
@@ -117,6 +142,7 @@ pub fn orbit_input(
     let pressed = [MouseButton::Left, MouseButton::Right, MouseButton::Middle].into_iter().find(|b| buttons.just_pressed(*b));
     if let Some(b) = pressed
         && pointer.inside
+        && !pointer.press_taken
     {
         *dragging = Some(b);
     }
@@ -125,17 +151,46 @@ pub fn orbit_input(
     }
     let Ok(mut orbit) = cams.single_mut() else { return };
     match *dragging {
+        Some(MouseButton::Left) if motion.delta != Vec2::ZERO && orbit.fly => orbit.look(motion.delta),
         Some(MouseButton::Left) if motion.delta != Vec2::ZERO => orbit.orbit(motion.delta),
         Some(MouseButton::Right | MouseButton::Middle) if motion.delta != Vec2::ZERO => orbit.pan(motion.delta, pointer.height),
         _ => {}
     }
-    if pointer.inside && scroll.delta.y != 0.0 {
-        let lines = match scroll.unit {
-            MouseScrollUnit::Line => scroll.delta.y,
-            MouseScrollUnit::Pixel => scroll.delta.y / MouseScrollUnit::SCROLL_UNIT_CONVERSION_FACTOR,
-        };
-        orbit.zoom(lines);
+    if pointer.inside && !pointer.wheel_taken && scroll.delta.y != 0.0 {
+        let lines = wheel_lines(&scroll);
+        if orbit.fly {
+            let step = orbit.fly_speed * 0.1 * lines;
+            orbit.fly_by(0.0, 0.0, step);
+        } else {
+            orbit.zoom(lines);
+        }
     }
+}
+
+/// Wheel turns in lines.
+pub fn wheel_lines(scroll: &AccumulatedMouseScroll) -> f32 {
+    match scroll.unit {
+        MouseScrollUnit::Line => scroll.delta.y,
+        MouseScrollUnit::Pixel => scroll.delta.y / MouseScrollUnit::SCROLL_UNIT_CONVERSION_FACTOR,
+    }
+}
+
+/// Fly-through keys: arrows move forward, back and sideways, Page Up / Down up and down,
+/// Shift four times faster.
+pub fn fly_keys(keys: Res<ButtonInput<KeyCode>>, time: Res<Time<Real>>, mut cams: Query<&mut OrbitCamera>) {
+    let Ok(mut orbit) = cams.single_mut() else { return };
+    if !orbit.fly {
+        return;
+    }
+    let axis = |plus: KeyCode, minus: KeyCode| keys.pressed(plus) as i32 as f32 - keys.pressed(minus) as i32 as f32;
+    let (right, up, forward) =
+        (axis(KeyCode::ArrowRight, KeyCode::ArrowLeft), axis(KeyCode::PageUp, KeyCode::PageDown), axis(KeyCode::ArrowUp, KeyCode::ArrowDown));
+    if right == 0.0 && up == 0.0 && forward == 0.0 {
+        return;
+    }
+    let boost = if keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]) { 4.0 } else { 1.0 };
+    let step = orbit.fly_speed * boost * time.delta_secs().min(0.1);
+    orbit.fly_by(right * step, up * step, forward * step);
 }
 
 /// Writes the orbit state into the camera's transform and projection.
@@ -187,5 +242,22 @@ mod tests {
         p.frame(View::Left, Vec3::splat(-10.0), Vec3::splat(10.0), 1.0);
         assert!(p.target.length() < 1e-5);
         assert!((p.azimuth_deg - 90.0).abs() < 1e-3 && p.elevation_deg.abs() < 1e-3, "{} {}", p.azimuth_deg, p.elevation_deg);
+    }
+
+    #[test]
+    fn flying_turns_about_the_eye_and_enters_the_volume() {
+        let mut o = OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 100.0, fly: true, ..Default::default() };
+        let eye = o.camera().position;
+        let right = o.camera().right();
+        // Dragging right turns the view to the right; the eye stays.
+        o.look(Vec2::new(50.0, 0.0));
+        assert!((o.camera().position - eye).length() < 1e-3, "{}", o.camera().position);
+        assert!(o.camera().forward().dot(right) > 0.1);
+        // Flying forward 150 units passes the old target (inside the volume).
+        let mut f = OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 100.0, ..Default::default() };
+        f.fly_by(0.0, 0.0, 150.0);
+        assert!((f.camera().position - Vec3::new(0.0, -50.0, 0.0)).length() < 1e-3, "{}", f.camera().position);
+        f.fly_by(10.0, 5.0, 0.0);
+        assert!((f.camera().position - Vec3::new(-10.0, -50.0, 5.0)).length() < 1e-3, "{}", f.camera().position);
     }
 }

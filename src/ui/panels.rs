@@ -9,7 +9,7 @@ use bevy_egui::{EguiContexts, egui::Ui};
 
 use super::loading::{DatasetOrigin, LoadRequest, Loading, Session};
 use super::orbit::{OrbitCamera, PointerInViewport};
-use super::{AppState, DialogPurpose, MainCamera, SHORTCUTS, scene_bounds, set_viewport, tf_editor};
+use super::{AppState, DialogPurpose, MainCamera, SHORTCUTS, lenses, scene_bounds, set_viewport, tf_editor};
 use crate::dataset::{Dataset, GpuVolume, SceneLight, SceneRegions};
 use crate::region::{Light, Lookup, Mode, View};
 use crate::transfer::presets;
@@ -29,6 +29,7 @@ pub fn ui(
     mut light: ResMut<SceneLight>,
     regions: Res<SceneRegions>,
     mut load: MessageWriter<LoadRequest>,
+    mut lens_params: lenses::LensParams,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(
@@ -100,6 +101,7 @@ pub fn ui(
                 egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| transfer_panel(ui, d, &mut state.editor));
                 egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| rendering_panel(ui, d, &mut state, &mut light));
             }
+            egui::CollapsingHeader::new("Lenses").default_open(true).show(ui, |ui| lenses::panel(ui, &mut lens_params));
             egui::CollapsingHeader::new("Camera").default_open(true).show(ui, |ui| {
                 if let Ok((mut orbit, _)) = cams.single_mut() {
                     camera_panel(ui, &mut orbit, scene_bounds(&regions));
@@ -116,6 +118,7 @@ pub fn ui(
     let over_free = ctx.pointer_hover_pos().is_some_and(|p| free.contains(p));
     pointer.inside = over_free && !ctx.is_pointer_over_egui() && !ctx.egui_is_using_pointer();
     pointer.height = free.height();
+    lenses::overlay(&ctx, free, &mut lens_params, &regions);
 
     if state.show_help {
         let mut open = true;
@@ -163,6 +166,7 @@ pub fn ui(
                     state.background,
                     light.0,
                     &session,
+                    &lens_params.ordered().into_iter().map(|(_, l, _)| l).collect::<Vec<_>>(),
                 );
                 if let Err(e) = result {
                     session.error = Some(e);
@@ -304,6 +308,10 @@ fn camera_panel(ui: &mut Ui, orbit: &mut OrbitCamera, bounds: (Vec3, Vec3)) {
             orbit.frame(View::Oblique, bounds.0, bounds.1, 1.0);
         }
         ui.checkbox(&mut orbit.orthographic, "orthographic");
+        let mut fly = orbit.fly;
+        if ui.checkbox(&mut fly, "fly-through (V)").changed() {
+            super::toggle_fly(orbit, bounds);
+        }
     });
     ui.add(egui::Slider::new(&mut orbit.fov_deg, 10.0..=90.0).text("field of view °"));
     ui.add(egui::Slider::new(&mut orbit.azimuth_deg, 0.0..=360.0).text("azimuth °"));
@@ -338,6 +346,7 @@ fn save_scene(
     background: [f32; 3],
     light: Light,
     session: &Session,
+    lenses: &[crate::lens::Lens],
 ) -> Result<(), String> {
     use crate::scene::save::{DatasetState, scene_file};
     let states: Vec<DatasetState> = rows
@@ -352,7 +361,7 @@ fn save_scene(
         .collect();
     let camera = camera.ok_or("no camera")?;
     let size = session.scene.as_ref().map(|s| s.size).unwrap_or((512, 512));
-    let scene = scene_file(&states, &camera, background, light, size, &session.base);
+    let scene = scene_file(&states, &camera, background, light, size, lenses, &session.base);
     let path = if path.extension().is_some_and(|e| e == "ron") { path.to_path_buf() } else { path.with_extension("ron") };
     std::fs::write(&path, scene.to_ron()?).map_err(|e| format!("{}: {e}", path.display()))
 }
