@@ -313,7 +313,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [(&str, fn(&mut Gpu)); 11] = [
+    let tests: [(&str, fn(&mut Gpu)); 12] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -325,6 +325,7 @@ fn main() {
         ("lens_ray_directions_match_the_reference", lenses::ray_directions_match_the_reference),
         ("magnifier_scales_a_sphere_by_m_squared", lenses::magnifier_scales_a_sphere_by_m_squared),
         ("outside_the_lens_the_image_is_unchanged", lenses::outside_the_lens_the_image_is_unchanged),
+        ("antialiasing_removes_moire_where_lenses_compress", lenses::antialiasing_removes_moire_where_lenses_compress),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

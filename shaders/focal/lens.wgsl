@@ -5,6 +5,7 @@
 // s = (x·aspect, y) in normalised device coordinates, one unit = half the view height.
 
 #import focal::types::{Lens, LENS_DATA}
+#import focal::sampling::set_lod
 #import focal::bindings::{view, settings}
 #import focal::camera::{Ray, pixel_ray}
 
@@ -192,4 +193,75 @@ fn lens_ray(uv: vec2<f32>) -> Ray {
         }
     }
     return ray;
+}
+
+// Anti-aliasing (reference: src/lens/antialias.rs, eq. 4). The rays of a pixel and its
+// right and lower neighbours lie dx = Δo_x + Δd_x·t and dy = Δo_y + Δd_y·t apart at
+// parameter t; the footprint's longest extent is the largest singular value of
+// [dx dy], and the mip level log2(1/mf) with mf its plain over its lensed value at the
+// same view depth.
+struct Spread {
+    ox: vec3<f32>,
+    dx: vec3<f32>,
+    oy: vec3<f32>,
+    dy: vec3<f32>,
+    depth0: f32,
+    depth_per_t: f32,
+}
+
+var<private> lensed_spread: Spread;
+var<private> plain_spread: Spread;
+var<private> has_footprint: bool = false;
+
+fn spread_of(r: Ray, rx: Ray, ry: Ray) -> Spread {
+    let d = normalize(r.dir);
+    let forward = -view.world_from_view[2].xyz;
+    return Spread(
+        rx.origin - r.origin,
+        normalize(rx.dir) - d,
+        ry.origin - r.origin,
+        normalize(ry.dir) - d,
+        dot(r.origin - view.world_position, forward),
+        dot(d, forward),
+    );
+}
+
+fn spread_extent(s: Spread, t: f32) -> f32 {
+    let x = s.ox + s.dx * t;
+    let y = s.oy + s.dy * t;
+    let a = dot(x, x);
+    let b = dot(x, y);
+    let c = dot(y, y);
+    let h = 0.5 * (a - c);
+    return sqrt(max(0.5 * (a + c) + sqrt(h * h + b * b), 0.0));
+}
+
+// Prepares the pixel's footprint (no anti-aliasing where a neighbour has no ray).
+fn lens_footprint(uv: vec2<f32>, ray: Ray) {
+    let px = vec2(1.0 / view.viewport.z, 0.0);
+    let py = vec2(0.0, 1.0 / view.viewport.w);
+    let rx = lens_ray(uv + px);
+    let ry = lens_ray(uv + py);
+    if dot(rx.dir, rx.dir) == 0.0 || dot(ry.dir, ry.dir) == 0.0 {
+        return;
+    }
+    lensed_spread = spread_of(ray, rx, ry);
+    plain_spread = spread_of(camera_ray(uv), camera_ray(uv + px), camera_ray(uv + py));
+    has_footprint = true;
+}
+
+// Sets the mip level of the samples at ray parameter t.
+fn update_lod(t: f32) {
+    if !has_footprint {
+        return;
+    }
+    let depth = lensed_spread.depth0 + lensed_spread.depth_per_t * t;
+    let tp = (depth - plain_spread.depth0) / max(plain_spread.depth_per_t, 1e-6);
+    let lensed = spread_extent(lensed_spread, t);
+    let plain = spread_extent(plain_spread, tp);
+    var lod = 3.0;
+    if lensed > 0.0 && plain > 0.0 {
+        lod = clamp(log2(lensed / plain), 0.0, 3.0);
+    }
+    set_lod(lod);
 }

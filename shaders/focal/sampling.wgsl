@@ -8,10 +8,51 @@
 #import focal::types::{Region, REGION_LABELS}
 #import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy, lut_atlas}
 
-// Trilinear sample (normalised) at continuous voxel index q, clamped to the edge voxels.
+// Mip level the samples come from: set per sample under lenses with anti-aliasing
+// (focal::lens::update_lod), 0 otherwise (reference: PreparedRegion::sample).
+var<private> sample_lod: f32 = 0.0;
+
+fn set_lod(lod: f32) {
+    sample_lod = lod;
+}
+
+// Trilinear sample of the atlas box at offset with dims, clamped to its edge voxels.
+fn trilinear_box(offset: vec3<f32>, dims: vec3<f32>, q: vec3<f32>) -> f32 {
+    let c = clamp(q, vec3(0.0), dims - 1.0);
+    return textureSampleLevel(volume_atlas, volume_sampler, (offset + c + 0.5) * scene.inv_atlas_size.xyz, 0.0).r;
+}
+
+// Sample of mip level k (volume::pyramid: index (q + ½)/2^k − ½, size ⌈dims/2^k⌉).
+fn level_sample(r: Region, q: vec3<f32>, k: u32) -> f32 {
+    if k == 0u {
+        return trilinear_box(r.atlas_offset.xyz, r.dims.xyz, q);
+    }
+    var offset = r.mips[0].xyz;
+    if k == 2u {
+        offset = r.mips[1].xyz;
+    } else if k == 3u {
+        offset = r.mips[2].xyz;
+    }
+    let s = exp2(f32(k));
+    return trilinear_box(offset, ceil(r.dims.xyz / s), (q + 0.5) / s - 0.5);
+}
+
+// Trilinear sample (normalised) at continuous voxel index q, clamped to the edge voxels;
+// under lenses from the current mip level (two levels blended).
 fn trilinear(r: Region, q: vec3<f32>) -> f32 {
-    let c = clamp(q, vec3(0.0), r.dims.xyz - 1.0);
-    return textureSampleLevel(volume_atlas, volume_sampler, (r.atlas_offset.xyz + c + 0.5) * scene.inv_atlas_size.xyz, 0.0).r;
+#ifdef HAS_LENSES
+    if sample_lod > 0.0 && r.mip_count > 0u {
+        let l = min(sample_lod, f32(r.mip_count));
+        let k = u32(floor(l));
+        let f = l - f32(k);
+        let a = level_sample(r, q, k);
+        if f > 0.0 {
+            return mix(a, level_sample(r, q, k + 1u), f);
+        }
+        return a;
+    }
+#endif
+    return trilinear_box(r.atlas_offset.xyz, r.dims.xyz, q);
 }
 
 // Code of the voxel nearest to q (label volumes).

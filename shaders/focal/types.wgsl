@@ -24,9 +24,11 @@ struct Region {
     reference_length: f32,
     iso: f32,
     gradient_max: f32,
-    pad_a: f32,
+    mip_count: u32,
     pad_b: f32,
     pad_c: f32,
+    // Atlas offsets of mip levels 1, 2, 3 (xyz).
+    mips: array<vec4<f32>, 3>,
 }
 
 struct Lens {
@@ -74,6 +76,7 @@ const VIEW_JITTER: u32 = 1u;
 const VIEW_SKIP_EMPTY: u32 = 2u;
 const VIEW_EARLY_TERMINATION: u32 = 4u;
 const VIEW_DEBUG_RAYS: u32 = 8u;
+const VIEW_LENS_ANTIALIAS: u32 = 16u;
 
 // Accumulated opacity at which a ray stops (reference: trace::EARLY_TERMINATION).
 const EARLY_TERMINATION: f32 = 0.99;

@@ -3,8 +3,10 @@
 //! Groups (all by default): `--skipping` (empty-space skipping on/off on a sparse label
 //! volume: the head phantom's arteries alone), `--termination` (early ray termination
 //! on/off on the dense head CT), `--modes` (every mode against DVR on the engine
-//! phantom). Each line ends with the ratio against its group's baseline; `--json` prints
-//! the same as JSON.
+//! phantom), `--lenses` (magic lenses against no lens on the head CT: a magnifier with
+//! and without anti-aliasing, the sampling-rate and angular lenses, four lenses at
+//! once; goal: at most 10 % overhead). Each line ends with the ratio against its
+//! group's baseline; `--json` prints the same as JSON.
 
 use std::sync::Arc;
 
@@ -12,6 +14,8 @@ use bevy::prelude::*;
 use clap::Args;
 use focal::FocalPlugins;
 use focal::dataset::Dataset;
+use focal::lens::systems::LensOrder;
+use focal::lens::{Lens, LensKind, Sampling};
 use focal::region::{Appearance, Lookup, Mode, View};
 use focal::render::VolumeView;
 use focal::render::headless::Offscreen;
@@ -40,6 +44,9 @@ pub struct BenchArgs {
     /// Only the modes group.
     #[arg(long)]
     modes: bool,
+    /// Only the lenses group.
+    #[arg(long)]
+    lenses: bool,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -60,6 +67,18 @@ struct Bench {
 }
 
 impl Bench {
+    /// Replaces the lenses of the view.
+    fn set_lenses(&mut self, lenses: &[Lens]) {
+        let world = self.off.world_mut();
+        let old: Vec<Entity> = world.query_filtered::<Entity, With<Lens>>().iter(world).collect();
+        for e in old {
+            world.despawn(e);
+        }
+        for (i, l) in lenses.iter().enumerate() {
+            world.spawn((l.clone(), LensOrder(i as u32)));
+        }
+    }
+
     fn show(&mut self, volume: Arc<Volume>, appearance: Appearance, view: VolumeView) -> Result<(f64, image::RgbaImage), String> {
         let world = self.off.world_mut();
         let old: Vec<Entity> = world.query_filtered::<Entity, With<Dataset>>().iter(world).collect();
@@ -87,7 +106,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         .split_once('x')
         .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
         .ok_or_else(|| format!("size '{}' is not WIDTHxHEIGHT", args.size))?;
-    let all = !(args.skipping || args.termination || args.modes);
+    let all = !(args.skipping || args.termination || args.modes || args.lenses);
     let off = Offscreen::new(w, h, |app| {
         app.add_plugins(FocalPlugins);
     })?;
@@ -163,6 +182,36 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
                 note: "engine phantom".into(),
             });
         }
+    }
+
+    if all || args.lenses {
+        let ct = Arc::new(Phantom::Head.generate(args.resolution)?);
+        let a = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone")?);
+        let (plain, _) = bench.show(ct.clone(), a.clone(), still)?;
+        let base = "no lens".to_string();
+        rows.push(Row { group: "lenses", config: base.clone(), ms: plain, baseline: base.clone(), ratio: 1.0, note: "head phantom, CT skin + bone".into() });
+        let magnifier = Lens::magnifier(Vec2::new(0.1, 0.05), 0.3, 0.15, 2.5);
+        let sampling = Lens { kind: LensKind::Sampling(Sampling::Cubic { center_rate: 3.0 }), ..Lens::magnifier(Vec2::ZERO, 0.5, 0.0, 1.0) };
+        let fisheye = Lens { kind: LensKind::Angular { field_of_view: 120.0, whole_view: false }, ..Lens::magnifier(Vec2::ZERO, 0.5, 0.0, 1.0) };
+        let four = vec![
+            Lens::magnifier(Vec2::new(-0.5, 0.4), 0.25, 0.1, 2.0),
+            Lens::magnifier(Vec2::new(0.5, 0.4), 0.25, 0.1, 3.0),
+            Lens { center: Vec2::new(-0.5, -0.4), radius: 0.3, ..sampling.clone() },
+            Lens { center: Vec2::new(0.5, -0.4), radius: 0.3, ..fisheye.clone() },
+        ];
+        let configs: Vec<(&str, Vec<Lens>, bool)> = vec![
+            ("magnifier", vec![magnifier.clone()], false),
+            ("magnifier + AA", vec![magnifier], true),
+            ("sampling + AA", vec![sampling], true),
+            ("angular + AA", vec![fisheye], true),
+            ("4 lenses + AA", four, true),
+        ];
+        for (name, lenses, antialias) in configs {
+            bench.set_lenses(&lenses);
+            let (ms, _) = bench.show(ct.clone(), a.clone(), VolumeView { lens_antialias: antialias, ..still })?;
+            rows.push(Row { group: "lenses", config: name.into(), ms, baseline: base.clone(), ratio: ms / plain.max(1e-9), note: "goal ≤ ×1.10".into() });
+        }
+        bench.set_lenses(&[]);
     }
 
     if args.json {

@@ -144,7 +144,12 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
         size: (512, 512),
         background: (0.0, 0.0, 0.0),
         light: Default::default(),
-        rendering: RenderingSpec { jitter: !args.no_jitter, skip_empty: !args.no_skip, early_termination: !args.no_early_termination },
+        rendering: RenderingSpec {
+            jitter: !args.no_jitter,
+            skip_empty: !args.no_skip,
+            early_termination: !args.no_early_termination,
+            lens_antialias: true,
+        },
         datasets: vec![DatasetSpec {
             name: None,
             source,

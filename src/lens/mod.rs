@@ -13,10 +13,12 @@
 //! - [`shape`]: circle, square and drawn outlines with their distance fields;
 //! - [`sampling`]: the sampling-rate lens (§3.3, eq. 5–7);
 //! - [`angular`]: the angular fisheye (§3.4);
+//! - [`antialias`]: mip levels where a lens compresses (eq. 4);
 //! - [`handles`]: grabbing, dragging and drawing lenses in the viewport;
 //! - [`lattice`]: the lens-distorted lattice overlay.
 
 pub mod angular;
+pub mod antialias;
 pub mod handles;
 pub mod lattice;
 pub mod magnifier;

@@ -15,6 +15,7 @@ use rayon::prelude::*;
 pub use image::RenderedImage;
 pub use trace::Traced;
 
+use crate::lens::antialias::Footprint;
 use crate::lens::{Lens, ResolvedLens, Screen, lens_ray};
 pub use crate::region::RenderScene;
 use crate::region::{Camera, Ray};
@@ -72,7 +73,9 @@ pub fn render_lensed(scene: &RenderScene, camera: &Camera, lenses: &[Lens], widt
                     return Traced::EMPTY;
                 };
                 let j = if scene.jitter { trace::jitter(x, y, 0) } else { 0.5 };
-                trace::trace(regions, scene.light, ray, j, DEPTH_THRESHOLD, false)
+                let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                let footprint = if scene.lens_antialias { Footprint::new(camera, screen, resolved, px, py) } else { None };
+                trace::trace_antialiased(regions, scene.light, ray, j, DEPTH_THRESHOLD, false, footprint.as_ref())
             })
         })
         .collect();

@@ -5,6 +5,7 @@ use glam::{Mat3, Vec3};
 
 use crate::region::{Appearance, Lookup, Mode, Region, Shading};
 use crate::transfer::Lut;
+use crate::volume::pyramid::level_index;
 use crate::volume::sample::VolumeSampler;
 use crate::volume::{BrickGrid, Volume};
 
@@ -100,6 +101,36 @@ impl<'a> PreparedRegion<'a> {
             Some((bricks, occ)) => occ[bricks.index(bricks.brick_at(q))],
             None => true,
         }
+    }
+
+    /// Trilinear sample at voxel position `q` from mip level `level` of the volume
+    /// (`crate::volume::pyramid`): level 0 is the volume itself, a fractional level
+    /// blends the two nearest, levels beyond the chain clamp to its top.
+    pub fn sample(&self, q: Vec3, level: f32) -> f32 {
+        if level <= 0.0 {
+            return self.sampler.trilinear(q);
+        }
+        let pyramid = self.volume.pyramid();
+        let level = level.min(pyramid.len() as f32);
+        let k = level.floor() as u32;
+        let at = |k: u32| match k {
+            0 => self.sampler.trilinear(q),
+            _ => {
+                let l = &pyramid[k as usize - 1];
+                VolumeSampler::new(&l.voxels, l.dims).trilinear(level_index(q, k))
+            }
+        };
+        let (a, f) = (at(k), level - k as f32);
+        if f > 0.0 { a + (at(k + 1) - a) * f } else { a }
+    }
+
+    /// [`Self::index_gradient`] of mip level `level`.
+    pub fn index_gradient_at(&self, q: Vec3, level: f32) -> Vec3 {
+        if level <= 0.0 || matches!(self.lookup, PreparedLookup::Labels(_)) {
+            return self.index_gradient(q);
+        }
+        let d = |e: Vec3| self.sample(q + e, level) - self.sample(q - e, level);
+        Vec3::new(d(Vec3::X), d(Vec3::Y), d(Vec3::Z)) * 0.5
     }
 
     /// Gradient at voxel position `q` in normalised units per voxel (index axes). Label

@@ -22,6 +22,8 @@
 use glam::{Vec3, Vec4};
 
 use super::prepare::PreparedRegion;
+use crate::lens::antialias::Footprint;
+use crate::volume::pyramid::MIP_LEVELS;
 use crate::region::{Light, Mode, Ray, Shading};
 use crate::transfer::opacity;
 
@@ -69,6 +71,20 @@ struct State {
 /// Traces one ray. `jitter` ∈ [0, 1) offsets the samples; `depth_threshold` is the
 /// accumulated opacity that defines the depth (and ends the ray when `stop_at_depth`).
 pub fn trace(regions: &[PreparedRegion], light: Light, ray: Ray, jitter: f32, depth_threshold: f32, stop_at_depth: bool) -> Traced {
+    trace_antialiased(regions, light, ray, jitter, depth_threshold, stop_at_depth, None)
+}
+
+/// [`trace`] under lenses with anti-aliasing: each sample comes from the mip level the
+/// pixel's footprint gives at its depth (`crate::lens::antialias`, eq. 4).
+pub fn trace_antialiased(
+    regions: &[PreparedRegion],
+    light: Light,
+    ray: Ray,
+    jitter: f32,
+    depth_threshold: f32,
+    stop_at_depth: bool,
+    footprint: Option<&Footprint>,
+) -> Traced {
     let mut out = Traced { color: Vec4::ZERO, value: f32::NAN, depth: f32::INFINITY, region: None, samples: 0 };
     let mut states: Vec<Option<State>> = Vec::with_capacity(regions.len());
     let (mut t_start, mut t_end, mut step) = (f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY);
@@ -110,6 +126,7 @@ pub fn trace(regions: &[PreparedRegion], light: Light, ray: Ray, jitter: f32, de
         k += 1;
         out.samples = k;
         let p = ray.at(t);
+        let level = footprint.map_or(0.0, |f| f.level(t, MIP_LEVELS as f32));
         for (i, r) in regions.iter().enumerate() {
             let Some(st) = states[i].as_mut() else { continue };
             if st.done {
@@ -130,7 +147,7 @@ pub fn trace(regions: &[PreparedRegion], light: Light, ray: Ray, jitter: f32, de
             let q = r.region.world_to_voxel.transform_point3(p);
             match r.mode {
                 Mode::Mip | Mode::MinIp | Mode::XRay => {
-                    let v = r.sampler.trilinear(q);
+                    let v = r.sample(q, level);
                     st.max = st.max.max(v);
                     st.min = st.min.min(v);
                     st.sum += v;
@@ -140,13 +157,13 @@ pub fn trace(regions: &[PreparedRegion], light: Light, ray: Ray, jitter: f32, de
                     if !r.occupied(q) {
                         continue;
                     }
-                    let v = r.sampler.trilinear(q);
+                    let v = r.sample(q, level);
                     let rgba = r.lookup.classify(v, r.sampler.nearest(q));
                     if rgba[3] <= 0.0 {
                         continue;
                     }
                     let mut alpha = opacity::correct(rgba[3], st.ratio);
-                    let g = r.index_gradient(q);
+                    let g = r.index_gradient_at(q, level);
                     if r.mode == Mode::GradientDvr {
                         alpha *= (g.length() / r.gradient_max).min(1.0);
                     }
@@ -154,14 +171,14 @@ pub fn trace(regions: &[PreparedRegion], light: Light, ray: Ray, jitter: f32, de
                     composite(&mut out, c, alpha, t, i, depth_threshold);
                 }
                 Mode::Iso => {
-                    let v = r.sampler.trilinear(q) - r.iso;
+                    let v = r.sample(q, level) - r.iso;
                     if let Some((tp, vp)) = st.prev
                         && (vp < 0.0) != (v < 0.0)
                     {
-                        let th = refine(r, &ray, (tp, vp), (t, v));
+                        let th = refine(r, &ray, (tp, vp), (t, v), level);
                         let qh = r.region.world_to_voxel.transform_point3(ray.at(th));
                         let rgba = r.lookup.classify(r.iso, r.sampler.nearest(qh));
-                        let g = r.index_gradient(qh);
+                        let g = r.index_gradient_at(qh, level);
                         let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), r.normal_matrix * g, view, light, &r.shading);
                         composite(&mut out, c, 1.0, th, i, depth_threshold);
                         st.done = true;
@@ -217,11 +234,11 @@ fn composite(out: &mut Traced, c: Vec3, alpha: f32, t: f32, region: usize, thres
 }
 
 /// Bisection between two samples on either side of the iso-value.
-fn refine(r: &PreparedRegion, ray: &Ray, (mut ta, va): (f32, f32), (mut tb, _): (f32, f32)) -> f32 {
+fn refine(r: &PreparedRegion, ray: &Ray, (mut ta, va): (f32, f32), (mut tb, _): (f32, f32), level: f32) -> f32 {
     let below = va < 0.0;
     for _ in 0..ISO_REFINEMENT {
         let tm = 0.5 * (ta + tb);
-        let v = r.sampler.trilinear(r.region.world_to_voxel.transform_point3(ray.at(tm))) - r.iso;
+        let v = r.sample(r.region.world_to_voxel.transform_point3(ray.at(tm)), level) - r.iso;
         if (v < 0.0) == below {
             ta = tm;
         } else {

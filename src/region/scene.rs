@@ -20,6 +20,8 @@ pub struct RenderScene {
     pub jitter: bool,
     /// Skip bricks the transfer function makes invisible (exact; off only to measure).
     pub skip_empty: bool,
+    /// Under lenses, sample compressed areas from the mip chain (`lens::antialias`).
+    pub lens_antialias: bool,
 }
 
 impl Default for RenderScene {
@@ -32,6 +34,7 @@ impl Default for RenderScene {
             light: Light::Headlight,
             jitter: false,
             skip_empty: true,
+            lens_antialias: true,
         }
     }
 }

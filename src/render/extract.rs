@@ -21,6 +21,8 @@ pub struct VolumeView {
     pub early_termination: bool,
     /// Show ray directions instead of the volumes (tests of ray generation).
     pub debug_rays: bool,
+    /// Under lenses, sample compressed areas from the mip chain (`lens::antialias`).
+    pub lens_antialias: bool,
     /// Seed of the jitter pattern.
     pub frame: u32,
     /// Light of the view (copied from the scene each frame).
@@ -29,7 +31,15 @@ pub struct VolumeView {
 
 impl Default for VolumeView {
     fn default() -> Self {
-        Self { jitter: true, skip_empty: true, early_termination: true, debug_rays: false, frame: 0, light: Light::Headlight }
+        Self {
+            jitter: true,
+            skip_empty: true,
+            early_termination: true,
+            debug_rays: false,
+            lens_antialias: true,
+            frame: 0,
+            light: Light::Headlight,
+        }
     }
 }
 
@@ -55,6 +65,9 @@ impl ExtractComponent for VolumeView {
         }
         if v.debug_rays {
             flags |= view_flags::DEBUG_RAYS;
+        }
+        if v.lens_antialias {
+            flags |= view_flags::LENS_ANTIALIAS;
         }
         let light = match v.light {
             Light::Headlight => Vec4::ZERO,

@@ -5,6 +5,8 @@ use bevy::prelude::Component;
 use bevy::render::render_resource::ShaderType;
 use glam::{Mat4, UVec4, Vec4};
 
+use crate::volume::pyramid::MIP_LEVELS;
+
 /// Mode numbers shared with the shader.
 pub mod mode {
     pub const DVR: u32 = 0;
@@ -57,6 +59,8 @@ pub mod view_flags {
     pub const EARLY_TERMINATION: u32 = 4;
     /// Output each pixel's ray direction as colour, `dir·½ + ½` (tests of ray generation).
     pub const DEBUG_RAYS: u32 = 8;
+    /// Sample compressed areas under lenses from the mip chain.
+    pub const LENS_ANTIALIAS: u32 = 16;
 }
 
 /// One region, with everything the shader needs about its volume and appearance.
@@ -90,9 +94,12 @@ pub struct GpuRegion {
     pub reference_length: f32,
     pub iso: f32,
     pub gradient_max: f32,
-    pub pad_a: f32,
+    /// Mip levels above the volume in the atlas (0 when the atlas has no room for them).
+    pub mip_count: u32,
     pub pad_b: f32,
     pub pad_c: f32,
+    /// Atlas texel offsets of mip levels 1… (xyz).
+    pub mips: [Vec4; MIP_LEVELS],
 }
 
 /// Lens kinds, shapes (codes shared with `shaders/focal/lens.wgsl`).

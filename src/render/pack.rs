@@ -11,6 +11,8 @@
 
 use glam::{Mat4, UVec3, Vec4};
 
+use crate::volume::pyramid::{MIP_LEVELS, half_dims};
+
 use super::gpu_types::{GpuRegion, mode, region_flags};
 use crate::reference::prepare::{PreparedLookup, PreparedRegion};
 use crate::region::{Mode, RenderScene};
@@ -30,8 +32,13 @@ pub struct PackedScene {
     pub occupancy: Vec<u32>,
     /// Scene volume indices placed in the atlases, in atlas order.
     pub volumes: Vec<usize>,
-    /// Where each of `volumes` lies in the volume atlas.
+    /// The boxes of the volume atlas: each of `volumes`, followed by its mip levels
+    /// when `mips`.
     pub atlas: Atlas,
+    /// The atlas holds the mip chains too (it does when they fit).
+    pub mips: bool,
+    /// Atlas offsets of each of `volumes`: the volume, then its mip levels.
+    pub levels: Vec<Vec<UVec3>>,
     /// Where each of `volumes`' brick grids lies in the brick atlas.
     pub brick_atlas: Atlas,
     /// Regions left out, with the reason (the atlas is full).
@@ -73,6 +80,21 @@ pub fn atlas_layout(sizes: &[UVec3], max: u32) -> Option<Atlas> {
     Some(Atlas { size, offsets })
 }
 
+/// Dimensions of a volume's boxes in the atlas: the volume, then (with `mips`) its levels.
+fn volume_boxes(dims: UVec3, mips: bool) -> Vec<UVec3> {
+    let mut boxes = vec![dims];
+    if mips {
+        for _ in 0..MIP_LEVELS {
+            let last = boxes[boxes.len() - 1];
+            if last == UVec3::ONE {
+                break;
+            }
+            boxes.push(half_dims(last));
+        }
+    }
+    boxes
+}
+
 impl PackedScene {
     /// Rows of the LUT atlas.
     pub fn lut_rows(&self) -> u32 {
@@ -102,12 +124,16 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         }
         let mut candidate = out.volumes.clone();
         candidate.push(p.region.volume);
-        let dims: Vec<UVec3> = candidate.iter().map(|&v| scene.volumes[v].dims()).collect();
+        let boxes = |mips: bool| -> Vec<UVec3> { candidate.iter().flat_map(|&v| volume_boxes(scene.volumes[v].dims(), mips)).collect() };
         let bricks: Vec<UVec3> = candidate.iter().map(|&v| scene.volumes[v].bricks().dims).collect();
-        match (atlas_layout(&dims, max_texture), atlas_layout(&bricks, max_texture)) {
-            (Some(a), Some(b)) => {
+        // Mip chains only while every volume's chain fits; volumes come first.
+        let with_mips = if out.mips || out.volumes.is_empty() { atlas_layout(&boxes(true), max_texture) } else { None };
+        let layout = with_mips.map(|a| (a, true)).or_else(|| atlas_layout(&boxes(false), max_texture).map(|a| (a, false)));
+        match (layout, atlas_layout(&bricks, max_texture)) {
+            (Some((a, mips)), Some(b)) => {
                 out.volumes = candidate;
                 out.atlas = a;
+                out.mips = mips;
                 out.brick_atlas = b;
             }
             _ => {
@@ -115,9 +141,16 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
             }
         }
     }
+    let mut next = 0;
+    for &v in &out.volumes {
+        let count = volume_boxes(scene.volumes[v].dims(), out.mips).len();
+        out.levels.push(out.atlas.offsets[next..next + count].to_vec());
+        next += count;
+    }
     for p in &prepared {
         let Some(slot) = out.volumes.iter().position(|&v| v == p.region.volume) else { continue };
-        let region = pack_region(p, out.atlas.offsets[slot], out.brick_atlas.offsets[slot], &mut out);
+        let levels = out.levels[slot].clone();
+        let region = pack_region(p, &levels, out.brick_atlas.offsets[slot], &mut out);
         out.regions.push(region);
     }
     out.features = scene_features(&out.regions);
@@ -160,7 +193,8 @@ pub fn scene_features(regions: &[GpuRegion]) -> u32 {
     bits
 }
 
-fn pack_region(p: &PreparedRegion, atlas_offset: UVec3, brick_offset: UVec3, out: &mut PackedScene) -> GpuRegion {
+/// Packs one region; `levels` are the atlas offsets of its volume and mip levels.
+fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &mut PackedScene) -> GpuRegion {
     let plane_offset = out.planes.len() as u32;
     out.planes.extend(p.region.planes.iter().map(|pl| pl.normal.extend(pl.offset)));
     let lut_offset = out.lut.len() as u32;
@@ -202,7 +236,7 @@ fn pack_region(p: &PreparedRegion, atlas_offset: UVec3, brick_offset: UVec3, out
         dims: p.volume.dims().as_vec3().extend(p.volume.code_max() as f32),
         shading: Vec4::new(s.ambient, s.diffuse, s.specular, s.shininess),
         bricks,
-        atlas_offset: atlas_offset.as_vec3().extend(0.0),
+        atlas_offset: levels[0].as_vec3().extend(0.0),
         brick_offset: brick_offset.extend(0),
         plane_offset,
         plane_count: p.region.planes.len() as u32,
@@ -217,9 +251,10 @@ fn pack_region(p: &PreparedRegion, atlas_offset: UVec3, brick_offset: UVec3, out
         reference_length: p.reference_length,
         iso: p.iso,
         gradient_max: p.gradient_max,
-        pad_a: 0.0,
+        mip_count: levels.len() as u32 - 1,
         pad_b: 0.0,
         pad_c: 0.0,
+        mips: std::array::from_fn(|k| levels.get(k + 1).map_or(Vec4::ZERO, |o| o.as_vec3().extend(1.0))),
     }
 }
 
@@ -241,7 +276,11 @@ mod tests {
         let packed = pack(&scene, 2048).unwrap();
         assert_eq!(packed.regions.len(), 2);
         assert_eq!(packed.volumes, vec![0]);
-        assert_eq!(packed.atlas.size, UVec3::splat(16));
+        // The volume and its mip levels 8³, 4³, 2³ stacked along z.
+        assert_eq!(packed.atlas.size, UVec3::new(16, 16, 30));
+        assert!(packed.mips);
+        assert_eq!(packed.regions[1].mip_count, 3);
+        assert_eq!(packed.regions[1].mips, [glam::Vec4::new(0.0, 0.0, 16.0, 1.0), glam::Vec4::new(0.0, 0.0, 24.0, 1.0), glam::Vec4::new(0.0, 0.0, 28.0, 1.0)]);
         assert_eq!((packed.regions[0].plane_offset, packed.regions[0].plane_count), (0, 6));
         assert_eq!((packed.regions[1].plane_offset, packed.regions[1].plane_count), (6, 7));
         assert_eq!(packed.regions[0].mode, mode::MIP);
@@ -276,6 +315,10 @@ mod tests {
         // A 16³ atlas holds two 8³ volumes stacked, not three (16 along x also fails).
         let packed = pack(&scene, 16).unwrap();
         assert_eq!(packed.regions.len(), 3, "three volumes fit as two columns");
+        // With their mip chains (15 texels deep each) only two would: the chains go.
+        assert!(!packed.mips && packed.regions.iter().all(|r| r.mip_count == 0));
+        let two = RenderScene { volumes: scene.volumes[..2].to_vec(), regions: scene.regions[..2].to_vec(), ..scene.clone() };
+        assert!(pack(&two, 16).unwrap().mips);
         let packed = pack(&scene, 12).unwrap();
         assert_eq!(packed.regions.len(), 1);
         assert_eq!(packed.dropped.len(), 2);

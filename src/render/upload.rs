@@ -16,7 +16,7 @@ use super::extract::ExtractedScene;
 use super::gpu_types::GpuSceneInfo;
 use super::pack::{LUT_ATLAS_WIDTH, PackedScene, pack};
 use crate::region::RenderScene;
-use crate::volume::Volume;
+use crate::volume::{Volume, Voxels};
 
 /// The 3D atlases of a set of volumes.
 pub struct GpuAtlases {
@@ -144,6 +144,13 @@ fn blit(dst: &mut [u8], size: UVec3, src: &[u8], dims: UVec3, offset: UVec3, bpp
     }
 }
 
+/// A volume's codes and those of its mip levels (built on first use; the atlas takes
+/// as many as it has room for).
+fn volume_levels(v: &Volume, mips: bool) -> impl Iterator<Item = (&Voxels, UVec3)> {
+    let levels: &[crate::volume::pyramid::Level] = if mips { v.pyramid() } else { &[] };
+    std::iter::once((&v.voxels, v.dims())).chain(levels.iter().map(|l| (&l.voxels, l.dims)))
+}
+
 /// The volume atlas (8-bit when every volume is, else 16-bit: 8-bit codes `c` become
 /// `257·c`, the same normalised value; `R16Float` halves `code / 65535` where
 /// `R16Unorm` is missing) and the brick min-max atlas (`Rg16Uint`, codes as stored).
@@ -153,13 +160,15 @@ fn atlases(device: &RenderDevice, queue: &RenderQueue, volumes: &[&Volume], pack
     let sixteen = volumes.iter().any(|v| v.voxels.bits() == 16);
     let (format, data) = if !sixteen {
         let mut data = vec![0u8; texels];
-        for (v, &o) in volumes.iter().zip(&packed.atlas.offsets) {
-            blit(&mut data, size, v.voxels.as_bytes(), v.dims(), o, 1);
+        for (slot, v) in volumes.iter().enumerate() {
+            for ((voxels, dims), &o) in volume_levels(v, packed.mips).zip(&packed.levels[slot]) {
+                blit(&mut data, size, voxels.as_bytes(), dims, o, 1);
+            }
         }
         (TextureFormat::R8Unorm, data)
     } else {
         let mut data = vec![0u8; texels * 2];
-        for (v, &o) in volumes.iter().zip(&packed.atlas.offsets) {
+        for (slot, v) in volumes.iter().enumerate() {
             let scale = if v.voxels.bits() == 8 { 257 } else { 1 };
             let encode = |c: u16| -> [u8; 2] {
                 let c = c as u32 * scale;
@@ -168,8 +177,10 @@ fn atlases(device: &RenderDevice, queue: &RenderQueue, volumes: &[&Volume], pack
                     _ => half::f16::from_f32(c as f32 / 65535.0).to_le_bytes(),
                 }
             };
-            let bytes: Vec<u8> = (0..v.voxels.len()).flat_map(|i| encode(v.voxels.code(i))).collect();
-            blit(&mut data, size, &bytes, v.dims(), o, 2);
+            for ((voxels, dims), &o) in volume_levels(v, packed.mips).zip(&packed.levels[slot]) {
+                let bytes: Vec<u8> = (0..voxels.len()).flat_map(|i| encode(voxels.code(i))).collect();
+                blit(&mut data, size, &bytes, dims, o, 2);
+            }
         }
         (format16, data)
     };

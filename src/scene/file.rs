@@ -84,11 +84,14 @@ pub struct RenderingSpec {
     pub skip_empty: bool,
     #[serde(default = "yes")]
     pub early_termination: bool,
+    /// Under lenses, sample compressed areas from the volume's mip chain (eq. 4).
+    #[serde(default = "yes")]
+    pub lens_antialias: bool,
 }
 
 impl Default for RenderingSpec {
     fn default() -> Self {
-        Self { jitter: true, skip_empty: true, early_termination: true }
+        Self { jitter: true, skip_empty: true, early_termination: true, lens_antialias: true }
     }
 }
 
@@ -300,6 +303,8 @@ pub enum Change {
     Light(Light),
     /// Replaces the view's lenses.
     Lenses(Vec<crate::lens::Lens>),
+    /// Replaces the rendering switches.
+    Rendering(RenderingSpec),
 }
 
 impl SceneFile {

@@ -228,6 +228,7 @@ pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneF
         Change::Background(c) => scene.background = *c,
         Change::Light(l) => scene.light = *l,
         Change::Lenses(l) => scene.lenses = l.clone(),
+        Change::Rendering(r) => scene.rendering = *r,
     }
     Ok(())
 }
@@ -239,6 +240,7 @@ pub fn render_scene(datasets: &[LoadedDataset], scene: &SceneFile) -> RenderScen
         light: scene.light,
         jitter: scene.rendering.jitter,
         skip_empty: scene.rendering.skip_empty,
+        lens_antialias: scene.rendering.lens_antialias,
         ..Default::default()
     };
     for d in datasets.iter().filter(|d| d.visible) {

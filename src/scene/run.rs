@@ -113,6 +113,7 @@ impl GpuRun {
             jitter: r.jitter,
             skip_empty: r.skip_empty,
             early_termination: r.early_termination,
+            lens_antialias: r.lens_antialias,
             ..Default::default()
         });
         self.off.set_background(scene.background());

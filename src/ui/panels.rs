@@ -285,6 +285,7 @@ fn rendering_panel(ui: &mut Ui, d: &mut Dataset, state: &mut AppState, light: &m
     ui.checkbox(&mut state.view.jitter, "jitter ray starts");
     ui.checkbox(&mut state.view.skip_empty, "skip empty space");
     ui.checkbox(&mut state.view.early_termination, "early ray termination");
+    ui.checkbox(&mut state.view.lens_antialias, "anti-alias where lenses compress");
 }
 
 fn camera_panel(ui: &mut Ui, orbit: &mut OrbitCamera, bounds: (Vec3, Vec3)) {

@@ -11,6 +11,7 @@ pub mod encode;
 pub mod grid;
 pub mod labels;
 pub mod phantom;
+pub mod pyramid;
 pub mod readers;
 pub mod resample;
 pub mod sample;
@@ -55,6 +56,7 @@ pub struct Volume {
     pub source: Source,
     bricks: OnceLock<BrickGrid>,
     gradient_max: OnceLock<f32>,
+    pyramid: OnceLock<Vec<pyramid::Level>>,
 }
 
 impl Clone for Volume {
@@ -68,6 +70,7 @@ impl Clone for Volume {
             source: self.source.clone(),
             bricks: self.bricks.clone(),
             gradient_max: self.gradient_max.clone(),
+            pyramid: self.pyramid.clone(),
         }
     }
 }
@@ -88,7 +91,7 @@ impl Volume {
             return Err(format!("value rescale {}·v + {} is not usable", values.slope, values.intercept));
         }
         let stats = stats::compute(&voxels, &values);
-        Ok(Volume { name: name.into(), grid, voxels, values, stats, source, bricks: OnceLock::new(), gradient_max: OnceLock::new() })
+        Ok(Volume { name: name.into(), grid, voxels, values, stats, source, bricks: OnceLock::new(), gradient_max: OnceLock::new(), pyramid: OnceLock::new() })
     }
 
     pub fn dims(&self) -> UVec3 {
@@ -124,6 +127,11 @@ impl Volume {
     /// The brick min-max grid (built on first use, [`DEFAULT_BRICK_SIZE`]).
     pub fn bricks(&self) -> &BrickGrid {
         self.bricks.get_or_init(|| BrickGrid::build(&self.voxels, self.grid.dims, DEFAULT_BRICK_SIZE))
+    }
+
+    /// Levels 1… of the mip chain (built on first use; see [`pyramid`]).
+    pub fn pyramid(&self) -> &[pyramid::Level] {
+        self.pyramid.get_or_init(|| pyramid::build(&self.voxels, self.grid.dims))
     }
 
     /// Largest central-difference gradient magnitude in normalised units per voxel,

@@ -1,0 +1,177 @@
+//! Anti-aliasing under lenses (Wang et al. 2005, §3.1, equation 4): where a lens
+//! compresses the image (local magnification `mf < 1`), neighbouring rays lie further
+//! apart than the data's detail, and samples alias. They are taken from the volume's
+//! mip chain ([`crate::volume::pyramid`]) at level
+//!
+//! `L = max(0, log₂(1/mf))`,
+//!
+//! blending the two nearest levels; where the lens magnifies, `L = 0`.
+//!
+//! `mf` is measured per sample with ray differentials: the rays of a pixel and of its
+//! right and lower neighbours are `Δ_x = Δo_x + Δd_x·t` and `Δ_y = Δo_y + Δd_y·t` apart
+//! at ray parameter `t` (`Δ` of origins and unit directions). A lens border compresses
+//! in one direction (radially) while it stretches in the other, so `mf` is the
+//! magnification in the most compressed direction: the pixel footprint's longest
+//! extent, the largest singular value `σ` of `[Δ_x Δ_y]`,
+//! `σ² = (a + c)/2 + √(((a − c)/2)² + b²)` with `a = Δ_x·Δ_x`, `b = Δ_x·Δ_y`,
+//! `c = Δ_y·Δ_y`, compared with the camera's own rays at the same view depth:
+//! `mf = σ_plain/σ_lensed`. (The geometric mean of the two directions, as in
+//! [`super::local_magnification`], would leave the radial moiré in place.) The shader
+//! computes the same differentials once per pixel and the level at every sample.
+
+use glam::Vec3;
+
+use super::stack::{ResolvedLens, Screen, lens_ray};
+use crate::region::{Camera, Ray};
+
+/// Differentials of a pixel's rays and the map from ray parameter to view depth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spread {
+    /// `Δo_x, Δd_x, Δo_y, Δd_y`.
+    pub deltas: [Vec3; 4],
+    /// View depth of the ray origin and its change per unit `t`.
+    pub depth0: f32,
+    pub depth_per_t: f32,
+}
+
+/// Largest singular value of the 3×2 matrix `[x y]`.
+pub fn largest_singular_value(x: Vec3, y: Vec3) -> f32 {
+    let (a, b, c) = (x.dot(x), x.dot(y), y.dot(y));
+    ((a + c) * 0.5 + (((a - c) * 0.5).powi(2) + b * b).sqrt()).max(0.0).sqrt()
+}
+
+impl Spread {
+    /// The spread of the rays `r` (the pixel), `rx` and `ry` (its neighbours).
+    pub fn of(camera: &Camera, r: Ray, rx: Ray, ry: Ray) -> Spread {
+        let d = r.dir.normalize_or_zero();
+        let fwd = camera.forward();
+        Spread {
+            deltas: [rx.origin - r.origin, rx.dir.normalize_or_zero() - d, ry.origin - r.origin, ry.dir.normalize_or_zero() - d],
+            depth0: (r.origin - camera.position).dot(fwd),
+            depth_per_t: d.dot(fwd),
+        }
+    }
+
+    /// Longest extent of the pixel footprint at ray parameter `t`.
+    pub fn extent(&self, t: f32) -> f32 {
+        let [ox, dx, oy, dy] = self.deltas;
+        largest_singular_value(ox + dx * t, oy + dy * t)
+    }
+
+    /// Ray parameter at view depth `z`.
+    pub fn t_at_depth(&self, z: f32) -> f32 {
+        (z - self.depth0) / self.depth_per_t.max(1e-6)
+    }
+}
+
+/// A pixel's lensed and plain ray spreads.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Footprint {
+    pub lensed: Spread,
+    pub plain: Spread,
+}
+
+impl Footprint {
+    /// The footprint of pixel position `(px, py)`; `None` where the pixel or a neighbour
+    /// has no ray (outside a whole-view fisheye).
+    pub fn new(camera: &Camera, screen: Screen, lenses: &[ResolvedLens], px: f32, py: f32) -> Option<Footprint> {
+        let lensed = |x: f32, y: f32| lens_ray(camera, screen, lenses, x, y);
+        let plain = |x: f32, y: f32| camera.ray(x, y, screen.width as u32, screen.height as u32);
+        Some(Footprint {
+            lensed: Spread::of(camera, lensed(px, py)?, lensed(px + 1.0, py)?, lensed(px, py + 1.0)?),
+            plain: Spread::of(camera, plain(px, py), plain(px + 1.0, py), plain(px, py + 1.0)),
+        })
+    }
+
+    /// Magnification `mf` in the most compressed direction at parameter `t` of the
+    /// lensed ray.
+    pub fn magnification(&self, t: f32) -> f32 {
+        let depth = self.lensed.depth0 + self.lensed.depth_per_t * t;
+        let plain = self.plain.extent(self.plain.t_at_depth(depth));
+        let lensed = self.lensed.extent(t);
+        if lensed <= 0.0 { f32::INFINITY } else { plain / lensed }
+    }
+
+    /// Mip level at parameter `t` (eq. 4), at most `max_level`.
+    pub fn level(&self, t: f32, max_level: f32) -> f32 {
+        level_for(self.magnification(t), max_level)
+    }
+}
+
+/// Equation 4: `L = max(0, log₂(1/mf))`, at most `max_level`.
+pub fn level_for(mf: f32, max_level: f32) -> f32 {
+    if mf.is_nan() || mf <= 0.0 { max_level } else { (-mf.log2()).clamp(0.0, max_level) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lens::stack::resolve;
+    use crate::lens::{Lens, LensKind, Sampling, local_magnification};
+    use crate::region::Projection;
+    use glam::Vec2;
+
+    #[test]
+    fn equation_4_by_hand() {
+        assert_eq!(level_for(1.0, 3.0), 0.0);
+        assert_eq!(level_for(3.0, 3.0), 0.0);
+        assert!((level_for(0.25, 3.0) - 2.0).abs() < 1e-6);
+        assert!((level_for(0.5f32.powf(1.5), 3.0) - 1.5).abs() < 1e-5);
+        assert_eq!(level_for(0.01, 3.0), 3.0);
+    }
+
+    #[test]
+    fn without_lenses_nothing_is_compressed() {
+        for projection in [Projection::Perspective { fov_y: 0.7 }, Projection::Orthographic { height: 200.0 }] {
+            let cam = Camera::look_at(Vec3::new(30.0, 400.0, 50.0), Vec3::ZERO, Vec3::Z, projection);
+            let f = Footprint::new(&cam, Screen::new(160, 120), &[], 20.0, 90.0).unwrap();
+            for t in [10.0, 300.0, 900.0] {
+                assert!((f.magnification(t) - 1.0).abs() < 1e-3, "{projection:?} {t}: {}", f.magnification(t));
+            }
+        }
+    }
+
+    #[test]
+    fn singular_values_by_hand() {
+        assert!((largest_singular_value(Vec3::new(3.0, 0.0, 0.0), Vec3::Y) - 3.0).abs() < 1e-6);
+        assert!((largest_singular_value(Vec3::new(1.0, 1.0, 0.0), Vec3::new(1.0, -1.0, 0.0)) - 2f32.sqrt()).abs() < 1e-6);
+        // A sheared square [1 1; 0 1]: σ = golden ratio.
+        assert!((largest_singular_value(Vec3::X, Vec3::new(1.0, 1.0, 0.0)) - 1.618_034).abs() < 1e-5);
+    }
+
+    #[test]
+    fn ray_differentials_agree_with_the_area_ratio_where_lenses_are_isotropic() {
+        // Two independent measures of mf: ray differentials along the ray, and the
+        // corner-square areas on the focus plane (`local_magnification`). They agree at
+        // lens centres (isotropic); in borders the most compressed direction is at
+        // most the geometric mean.
+        let screen = Screen::new(200, 200);
+        for projection in [Projection::Perspective { fov_y: 0.6 }, Projection::Orthographic { height: 200.0 }] {
+            let cam = Camera::look_at(Vec3::new(0.0, 0.0, 500.0), Vec3::ZERO, Vec3::Y, projection);
+            let lenses = [
+                Lens::magnifier(Vec2::ZERO, 0.3, 0.3, 3.0),
+                Lens { kind: LensKind::Sampling(Sampling::Custom(vec![2.0, 2.0, 0.4, 1.0])), ..Lens::magnifier(Vec2::ZERO, 0.5, 0.0, 1.0) },
+            ];
+            for lens in lenses {
+                let resolved = [resolve(&lens, &cam, screen, (Vec3::ZERO, 100.0))];
+                for (px, py, centre) in [(100.0, 100.0, true), (130.0, 100.0, false), (150.0, 110.0, false), (170.0, 100.0, false)] {
+                    let f = Footprint::new(&cam, screen, &resolved, px, py).unwrap();
+                    let mf = f.magnification(f.lensed.t_at_depth(500.0));
+                    let mean = local_magnification(&cam, screen, &resolved, px + 0.5, py + 0.5, 500.0).unwrap();
+                    let name = lens.kind_name();
+                    if centre {
+                        assert!((mf / mean - 1.0).abs() < 0.05, "{projection:?} {name} centre: {mf} vs {mean}");
+                    } else {
+                        assert!(mf <= mean * 1.02, "{projection:?} {name} at ({px}, {py}): {mf} > {mean}");
+                    }
+                }
+            }
+        }
+        // The border of the magnifier compresses radially: there mf < 1 and L > 0.
+        let cam = Camera::look_at(Vec3::new(0.0, 0.0, 500.0), Vec3::ZERO, Vec3::Y, Projection::Orthographic { height: 200.0 });
+        let resolved = [resolve(&Lens::magnifier(Vec2::ZERO, 0.4, 0.3, 3.0), &cam, screen, (Vec3::ZERO, 100.0))];
+        let f = Footprint::new(&cam, screen, &resolved, 155.0, 100.0).unwrap();
+        let t = f.lensed.t_at_depth(500.0);
+        assert!(f.magnification(t) < 0.6 && f.level(t, 3.0) > 0.7, "{} {}", f.magnification(t), f.level(t, 3.0));
+    }
+}
