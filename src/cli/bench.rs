@@ -14,7 +14,7 @@ use bevy::prelude::*;
 use clap::Args;
 use focal::FocalPlugins;
 use focal::dataset::Dataset;
-use focal::lens::systems::LensOrder;
+use focal::lens::systems::replace_lenses;
 use focal::lens::{Lens, LensKind, Sampling};
 use focal::region::{Appearance, Lookup, Mode, View};
 use focal::render::VolumeView;
@@ -67,18 +67,6 @@ struct Bench {
 }
 
 impl Bench {
-    /// Replaces the lenses of the view.
-    fn set_lenses(&mut self, lenses: &[Lens]) {
-        let world = self.off.world_mut();
-        let old: Vec<Entity> = world.query_filtered::<Entity, With<Lens>>().iter(world).collect();
-        for e in old {
-            world.despawn(e);
-        }
-        for (i, l) in lenses.iter().enumerate() {
-            world.spawn((l.clone(), LensOrder(i as u32)));
-        }
-    }
-
     fn show(&mut self, volume: Arc<Volume>, appearance: Appearance, view: VolumeView) -> Result<(f64, image::RgbaImage), String> {
         let world = self.off.world_mut();
         let old: Vec<Entity> = world.query_filtered::<Entity, With<Dataset>>().iter(world).collect();
@@ -207,11 +195,11 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             ("4 lenses + AA", four, true),
         ];
         for (name, lenses, antialias) in configs {
-            bench.set_lenses(&lenses);
+            replace_lenses(bench.off.world_mut(), &lenses);
             let (ms, _) = bench.show(ct.clone(), a.clone(), VolumeView { lens_antialias: antialias, ..still })?;
             rows.push(Row { group: "lenses", config: name.into(), ms, baseline: base.clone(), ratio: ms / plain.max(1e-9), note: "goal ≤ ×1.10".into() });
         }
-        bench.set_lenses(&[]);
+        replace_lenses(bench.off.world_mut(), &[]);
     }
 
     if args.json {

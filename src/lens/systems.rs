@@ -63,6 +63,17 @@ pub fn resolve_view_lenses(
     }
 }
 
+/// Replaces every lens entity of `world` with `lenses`, in stack order.
+pub fn replace_lenses(world: &mut World, lenses: &[Lens]) {
+    let old: Vec<Entity> = world.query_filtered::<Entity, With<Lens>>().iter(world).collect();
+    for e in old {
+        world.despawn(e);
+    }
+    for (i, lens) in lenses.iter().enumerate() {
+        world.spawn((lens.clone(), LensOrder(i as u32), Name::new(format!("lens {}", lens.kind_name()))));
+    }
+}
+
 /// Adds [`ViewLenses`] to every volume camera.
 fn add_view_lenses(mut commands: Commands, views: Query<Entity, (With<VolumeView>, Without<ViewLenses>)>) {
     for e in &views {

@@ -11,7 +11,7 @@ use super::file::{FrameSpec, SceneFile};
 use super::load::{LoadedDataset, apply, camera, load_datasets, read_scene, render_scene, visible_bounds};
 use crate::FocalPlugins;
 use crate::dataset::{Dataset, SceneLight};
-use crate::lens::systems::LensOrder;
+use crate::lens::systems::replace_lenses;
 use crate::reference::render_lensed;
 use crate::render::VolumeView;
 use crate::render::headless::Offscreen;
@@ -85,7 +85,6 @@ pub fn render_frames(mut scene: SceneFile, base: &Path, options: &RunOptions) ->
 struct GpuRun {
     off: Offscreen,
     entities: Vec<Entity>,
-    lenses: Vec<Entity>,
 }
 
 impl GpuRun {
@@ -94,7 +93,7 @@ impl GpuRun {
             app.add_plugins(FocalPlugins);
         })?;
         let entities = datasets.iter().map(|d| off.world_mut().spawn((dataset_component(d), transform(d))).id()).collect();
-        Ok(GpuRun { off, entities, lenses: Vec::new() })
+        Ok(GpuRun { off, entities })
     }
 
     fn capture(&mut self, datasets: &[LoadedDataset], scene: &SceneFile, cam: &crate::region::Camera) -> Result<image::RgbaImage, String> {
@@ -102,12 +101,7 @@ impl GpuRun {
             self.off.world_mut().entity_mut(*e).insert((dataset_component(d), transform(d)));
         }
         self.off.world_mut().insert_resource(SceneLight(scene.light));
-        for e in self.lenses.drain(..) {
-            self.off.world_mut().despawn(e);
-        }
-        for (i, lens) in scene.lenses.iter().enumerate() {
-            self.lenses.push(self.off.world_mut().spawn((lens.clone(), LensOrder(i as u32))).id());
-        }
+        replace_lenses(self.off.world_mut(), &scene.lenses);
         let r = scene.rendering;
         self.off.set_view(VolumeView {
             jitter: r.jitter,

@@ -3,19 +3,12 @@
 //! outside a lens.
 
 use super::*;
-use focal::lens::{Lens, LensKind, Profile, Sampling, Screen, Shape, lens_ray, systems::LensOrder};
+use focal::lens::{Lens, LensKind, Profile, Sampling, Screen, Shape, lens_ray, systems::replace_lenses};
 use focal::reference::render_lensed;
 use focal::transfer::color::srgb_to_linear;
 
 fn set_lenses(gpu: &mut Gpu, lenses: &[Lens]) {
-    let world = gpu.off.world_mut();
-    let old: Vec<Entity> = world.query_filtered::<Entity, With<Lens>>().iter(world).collect();
-    for e in old {
-        world.despawn(e);
-    }
-    for (i, l) in lenses.iter().enumerate() {
-        world.spawn((l.clone(), LensOrder(i as u32)));
-    }
+    replace_lenses(gpu.off.world_mut(), lenses);
 }
 
 fn show_lensed(gpu: &mut Gpu, volume: Arc<Volume>, appearance: Appearance, camera: &FocalCamera, lenses: &[Lens]) -> image::RgbaImage {
