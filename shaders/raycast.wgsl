@@ -18,7 +18,7 @@
 #import focal::types::{Region, MODE_MIP, MODE_MIN_IP, MODE_X_RAY, MODE_GRADIENT_DVR, MODE_ISO, REGION_LABELS, REGION_SHADING, REGION_OCCUPANCY, VIEW_JITTER, VIEW_SKIP_EMPTY, VIEW_EARLY_TERMINATION, VIEW_DEBUG_RAYS, VIEW_LENS_ANTIALIAS, EARLY_TERMINATION, ISO_REFINEMENT, MAX_RAY_REGIONS}
 #import focal::bindings::{settings, scene, regions, depth_texture}
 #import focal::camera::{Ray, pixel_ray, scene_depth_t, jitter}
-#import focal::lens::{lens_ray, lens_footprint, update_lod}
+#import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod}
 #import focal::regions::{region_interval, to_voxel, dir_to_voxel, world_step}
 #import focal::sampling::{trilinear, nearest_code, index_gradient, brick_occupied, brick_exit, brick_range}
 #import focal::transfer::{classify, classify_label, correct_opacity}
@@ -170,6 +170,9 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
         stop = EARLY_TERMINATION;
     }
     let t_last = min(t_end, t_scene);
+#ifdef HAS_LENSES
+    restrict_footprint(t_start, t_last);
+#endif
 
     // 2.–4. Walk the segments.
     var acc = vec4(0.0);

@@ -250,18 +250,31 @@ fn lens_footprint(uv: vec2<f32>, ray: Ray) {
     has_footprint = true;
 }
 
-// Sets the mip level of the samples at ray parameter t.
-fn update_lod(t: f32) {
-    if !has_footprint {
-        return;
-    }
+// Mip level at ray parameter t.
+fn lod_at(t: f32) -> f32 {
     let depth = lensed_spread.depth0 + lensed_spread.depth_per_t * t;
     let tp = (depth - plain_spread.depth0) / max(plain_spread.depth_per_t, 1e-6);
     let lensed = spread_extent(lensed_spread, t);
     let plain = spread_extent(plain_spread, tp);
-    var lod = 3.0;
     if lensed > 0.0 && plain > 0.0 {
-        lod = clamp(log2(lensed / plain), 0.0, 3.0);
+        return clamp(log2(lensed / plain), 0.0, 3.0);
     }
-    set_lod(lod);
+    return 3.0;
+}
+
+// Restricts the footprint to the ray's interval [t0, t1]: the lensed extent is convex in
+// t (the largest singular value of a matrix affine in t) and the plain one affine, so
+// their ratio is quasi-convex and its maximum over the interval lies at an end. Level 0
+// at both ends means level 0 throughout: the per-sample work is skipped (exactly).
+fn restrict_footprint(t0: f32, t1: f32) {
+    if has_footprint && lod_at(t0) <= 0.0 && lod_at(t1) <= 0.0 {
+        has_footprint = false;
+    }
+}
+
+// Sets the mip level of the samples at ray parameter t.
+fn update_lod(t: f32) {
+    if has_footprint {
+        set_lod(lod_at(t));
+    }
 }

@@ -18,6 +18,12 @@
 //! `mf = σ_plain/σ_lensed`. (The geometric mean of the two directions, as in
 //! [`super::local_magnification`], would leave the radial moiré in place.) The shader
 //! computes the same differentials once per pixel and the level at every sample.
+//!
+//! The lensed extent is convex in `t` (the largest singular value of a matrix affine in
+//! `t`) and the plain one affine in `t` (rays from one eye, or parallel), so their ratio
+//! is quasi-convex: over a ray's interval its maximum lies at an end. Where the level is
+//! 0 at both ends of the interval it is 0 throughout, and the shader skips the
+//! per-sample work for that pixel (an exact shortcut; [`Footprint::level_free`]).
 
 use glam::Vec3;
 
@@ -90,6 +96,11 @@ impl Footprint {
         let plain = self.plain.extent(self.plain.t_at_depth(depth));
         let lensed = self.lensed.extent(t);
         if lensed <= 0.0 { f32::INFINITY } else { plain / lensed }
+    }
+
+    /// Whether the level is 0 all over `[t0, t1]` (both ends suffice, see the module docs).
+    pub fn level_free(&self, t0: f32, t1: f32) -> bool {
+        self.magnification(t0) >= 1.0 && self.magnification(t1) >= 1.0
     }
 
     /// Mip level at parameter `t` (eq. 4), at most `max_level`.
@@ -173,5 +184,47 @@ mod tests {
         let f = Footprint::new(&cam, screen, &resolved, 155.0, 100.0).unwrap();
         let t = f.lensed.t_at_depth(500.0);
         assert!(f.magnification(t) < 0.6 && f.level(t, 3.0) > 0.7, "{} {}", f.magnification(t), f.level(t, 3.0));
+    }
+
+    #[test]
+    fn compression_peaks_at_the_ends_of_an_interval() {
+        // Quasi-convexity of 1/mf along a ray: mf(t) ≥ min(mf(t0), mf(t1)) in between,
+        // for every lens kind, both projections, pixels all over the image.
+        let screen = Screen::new(120, 120);
+        for projection in [Projection::Perspective { fov_y: 0.8 }, Projection::Orthographic { height: 200.0 }] {
+            let cam = Camera::look_at(Vec3::new(40.0, -300.0, 120.0), Vec3::ZERO, Vec3::Z, projection);
+            let lenses = [
+                Lens::magnifier(Vec2::new(0.1, 0.0), 0.3, 0.4, 4.0),
+                Lens {
+                    kind: crate::lens::LensKind::Magnifier {
+                        magnification: 3.0,
+                        profile: crate::lens::Profile::Linear,
+                        focus_depth: None,
+                        plane_depth: Some(150.0),
+                    },
+                    ..Lens::magnifier(Vec2::new(-0.2, 0.1), 0.25, 0.3, 3.0)
+                },
+                Lens { kind: LensKind::Sampling(Sampling::Custom(vec![3.0, 0.3, 1.0])), ..Lens::magnifier(Vec2::ZERO, 0.6, 0.0, 1.0) },
+                Lens { kind: LensKind::Angular { field_of_view: 200.0, whole_view: false }, ..Lens::magnifier(Vec2::ZERO, 0.5, 0.0, 1.0) },
+            ];
+            for lens in lenses {
+                let resolved = [resolve(&lens, &cam, screen, (Vec3::ZERO, 100.0))];
+                for py in (3..120).step_by(9) {
+                    for px in (3..120).step_by(9) {
+                        let Some(f) = Footprint::new(&cam, screen, &resolved, px as f32, py as f32) else { continue };
+                        let (t0, t1) = (200.0, 500.0);
+                        let ends = f.magnification(t0).min(f.magnification(t1));
+                        for k in 1..30 {
+                            let t = t0 + (t1 - t0) * k as f32 / 30.0;
+                            let mf = f.magnification(t);
+                            assert!(mf >= ends * (1.0 - 1e-3), "{} ({px}, {py}) t = {t}: {mf} < {ends}", lens.kind_name());
+                            if f.level_free(t0, t1) {
+                                assert!(f.level(t, 3.0) < 1e-3, "{}", f.level(t, 3.0));
+                            }
+                        }
+                    }
+                }
+            }
+        }
     }
 }
