@@ -158,14 +158,19 @@ fn each_mode_matches_the_reference(gpu: &mut Gpu) {
     }
 }
 
-fn labels_match_the_reference(gpu: &mut Gpu) {
+/// The head phantom's label volume, every label at opacity 0.3.
+fn labelled_head() -> (Arc<Volume>, Appearance) {
     let h = phantom::head::generate(64).unwrap();
     let ids = h.labels.present_ids().into_iter().map(|(id, _)| id);
     let a = Appearance {
         lookup: Lookup::Labels(LabelTransfer::from_table(&h.labels.table, ids, 0.3)),
         ..Appearance::new(Mode::Dvr, opaque_ramp())
     };
-    let v = Arc::new(h.labels.volume);
+    (Arc::new(h.labels.volume), a)
+}
+
+fn labels_match_the_reference(gpu: &mut Gpu) {
+    let (v, a) = labelled_head();
     let cam = framed(&v, View::Oblique, false);
     let g = gpu.show(v.clone(), a.clone(), &cam);
     assert_matches("labels_head", &g, &cpu(v, a, &cam));
@@ -313,7 +318,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [(&str, fn(&mut Gpu)); 12] = [
+    let tests: [(&str, fn(&mut Gpu)); 13] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -326,6 +331,7 @@ fn main() {
         ("magnifier_scales_a_sphere_by_m_squared", lenses::magnifier_scales_a_sphere_by_m_squared),
         ("outside_the_lens_the_image_is_unchanged", lenses::outside_the_lens_the_image_is_unchanged),
         ("antialiasing_removes_moire_where_lenses_compress", lenses::antialiasing_removes_moire_where_lenses_compress),
+        ("feature_lens_matches_the_reference", lenses::feature_lens_matches_the_reference),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

@@ -14,3 +14,4 @@
 @group(0) @binding(8) var brick_atlas: texture_3d<u32>;
 @group(0) @binding(9) var volume_sampler: sampler;
 @group(0) @binding(10) var depth_texture: texture_depth_2d;
+@group(0) @binding(11) var<storage, read> feature_fields: array<f32>;

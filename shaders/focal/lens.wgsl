@@ -6,7 +6,7 @@
 
 #import focal::types::{Lens, LENS_DATA}
 #import focal::sampling::set_lod
-#import focal::bindings::{view, settings}
+#import focal::bindings::{view, settings, feature_fields}
 #import focal::camera::{Ray, pixel_ray}
 
 const LENS_MAGNIFIER: u32 = 0u;
@@ -14,6 +14,7 @@ const LENS_SAMPLING: u32 = 1u;
 const LENS_ANGULAR: u32 = 2u;
 const SHAPE_SQUARE: u32 = 1u;
 const SHAPE_POLYGON: u32 = 2u;
+const SHAPE_FEATURE: u32 = 3u;
 const PROFILE_SIMPLE: u32 = 0u;
 const PROFILE_LINEAR: u32 = 1u;
 const SAMPLING_TABLE: u32 = 64u;
@@ -73,7 +74,35 @@ fn outline_distance(base: u32, n: u32, p: vec2<f32>) -> f32 {
     return sqrt(d2);
 }
 
+// Signed distance to a feature's silhouette at lens coordinates s: bilinear between
+// cell centres, beyond the grid the edge value plus the distance to the edge
+// (reference: FeatureField::distance_at).
+fn feature_distance(base: u32, s: vec2<f32>) -> f32 {
+    let g = settings.lens_data[base];
+    let h = settings.lens_data[base + 1u];
+    let cols = u32(g.x);
+    let rows = u32(g.y);
+    let gx = (s.x - g.z) / h.x;
+    let gy = (g.w - s.y) / h.y;
+    let x = clamp(gx, 0.0, g.x - 1.0);
+    let y = clamp(gy, 0.0, g.y - 1.0);
+    let beyond = length(vec2((gx - x) * h.x, (gy - y) * h.y));
+    let x0 = u32(floor(x));
+    let y0 = u32(floor(y));
+    let x1 = min(x0 + 1u, cols - 1u);
+    let y1 = min(y0 + 1u, rows - 1u);
+    let fx = x - f32(x0);
+    let fy = y - f32(y0);
+    let o = u32(h.z);
+    let top = mix(feature_fields[o + y0 * cols + x0], feature_fields[o + y0 * cols + x1], fx);
+    let bottom = mix(feature_fields[o + y1 * cols + x0], feature_fields[o + y1 * cols + x1], fx);
+    return mix(top, bottom, fy) + beyond;
+}
+
 fn radial(lens: Lens, base: u32, v: vec2<f32>) -> f32 {
+    if lens.codes.y == SHAPE_FEATURE {
+        return lens.geometry.z + feature_distance(base, lens.geometry.xy + v);
+    }
     if lens.codes.y == SHAPE_SQUARE {
         return max(abs(v.x), abs(v.y));
     }

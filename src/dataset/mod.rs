@@ -77,7 +77,9 @@ pub fn collect_regions(
         scene.volumes.push(volume);
         scene.appearances.push(d.appearance.clone());
     }
-    out.scene = scene;
+    if out.scene != scene {
+        out.scene = scene;
+    }
 }
 
 /// Datasets and the scene regions, without any GPU.

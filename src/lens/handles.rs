@@ -32,9 +32,9 @@ fn radial(lens: &Lens, s: Vec2) -> f32 {
 }
 
 /// The handle of `lens` at `s`, if any (`tolerance` in lens units). A whole-view
-/// fisheye has no handles.
+/// fisheye and a feature lens (it follows its feature) have no handles.
 pub fn hit(lens: &Lens, s: Vec2, tolerance: f32) -> Option<Handle> {
-    if matches!(lens.kind, LensKind::Angular { whole_view: true, .. }) {
+    if matches!(lens.kind, LensKind::Angular { whole_view: true, .. }) || matches!(lens.shape, Shape::Feature(_)) {
         return None;
     }
     let r = radial(lens, s);

@@ -14,11 +14,13 @@
 //! - [`sampling`]: the sampling-rate lens (§3.3, eq. 5–7);
 //! - [`angular`]: the angular fisheye (§3.4);
 //! - [`antialias`]: mip levels where a lens compresses (eq. 4);
+//! - [`feature`]: the feature lens, shaped by a segmented feature's silhouette (§3.2);
 //! - [`handles`]: grabbing, dragging and drawing lenses in the viewport;
 //! - [`lattice`]: the lens-distorted lattice overlay.
 
 pub mod angular;
 pub mod antialias;
+pub mod feature;
 pub mod handles;
 pub mod lattice;
 pub mod magnifier;

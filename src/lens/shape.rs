@@ -28,6 +28,9 @@ pub enum Shape {
     Square,
     /// A user-drawn closed outline, vertices relative to the lens centre in lens units.
     Polygon(Vec<Vec2>),
+    /// The silhouette of a segmented feature in the view (the feature lens, see
+    /// [`super::feature`]); resolved per view, a circle where no view is at hand.
+    Feature(super::feature::FeatureRef),
 }
 
 impl Shape {
@@ -35,7 +38,7 @@ impl Shape {
     /// radius).
     pub fn radial(&self, v: Vec2) -> f32 {
         match self {
-            Shape::Circle => v.length(),
+            Shape::Circle | Shape::Feature(_) => v.length(),
             Shape::Square => v.x.abs().max(v.y.abs()),
             Shape::Polygon(points) => polygon_radius(points) + signed_distance(points, v),
         }

@@ -122,13 +122,13 @@ impl Lens {
                 Ok(())
             }
             LensKind::Sampling(s) => {
-                if matches!(self.shape, Shape::Polygon(_)) {
+                if matches!(self.shape, Shape::Polygon(_) | Shape::Feature(_)) {
                     return Err("a sampling lens is a circle or a square".into());
                 }
                 s.validate()
             }
             LensKind::Angular { field_of_view, .. } => {
-                if matches!(self.shape, Shape::Polygon(_) | Shape::Square) {
+                if matches!(self.shape, Shape::Polygon(_) | Shape::Square | Shape::Feature(_)) {
                     return Err("an angular lens is a circle".into());
                 }
                 if !(field_of_view.is_finite() && *field_of_view > 0.0 && *field_of_view <= 360.0) {

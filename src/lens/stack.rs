@@ -10,12 +10,15 @@
 
 use glam::{Vec2, Vec3};
 
+use std::sync::Arc;
+
 use super::angular::fisheye;
+use super::feature::{FeatureField, feature_mask, grid_size};
 use super::magnifier::Magnifier;
 use super::sampling::{TABLE_SIZE, lookup};
 use super::shape::Shape;
 use super::spec::{Lens, LensKind};
-use crate::region::{Camera, Projection, Ray};
+use crate::region::{Camera, Projection, Ray, RenderScene};
 
 /// Most lenses per view (the GPU keeps them in the view uniform).
 pub const MAX_LENSES: usize = 4;
@@ -69,11 +72,13 @@ pub enum Effect {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ResolvedLens {
     pub center: Vec2,
-    /// Focus radius (the equivalent radius for a drawn shape).
+    /// Focus radius (the equivalent radius for a drawn shape or a feature).
     pub radius: f32,
     pub border: f32,
     pub shape: Shape,
     pub effect: Effect,
+    /// A feature lens's silhouette in this view.
+    pub field: Option<Arc<FeatureField>>,
 }
 
 /// Resolves `lens` for `camera`; `scene` is the bounding sphere of what is shown
@@ -97,15 +102,39 @@ pub fn resolve(lens: &Lens, camera: &Camera, screen: Screen, scene: (Vec3, f32))
         }
     };
     let center = if matches!(effect, Effect::Angular { whole_view: true, .. }) { Vec2::ZERO } else { lens.center };
-    ResolvedLens { center, radius, border: lens.border, shape: lens.shape.clone(), effect }
+    ResolvedLens { center, radius, border: lens.border, shape: lens.shape.clone(), effect, field: None }
+}
+
+/// Resolves `lens` for `camera` in `scene`: a feature lens finds its feature's
+/// silhouette ([`super::feature`]) and centres on it; `None` when its feature is not in
+/// view.
+pub fn resolve_in(lens: &Lens, camera: &Camera, screen: Screen, scene: &RenderScene) -> Option<ResolvedLens> {
+    let bounds = scene.bounding_sphere();
+    let Shape::Feature(feature) = &lens.shape else { return Some(resolve(lens, camera, screen, bounds)) };
+    let (cols, rows) = grid_size(screen);
+    let field = FeatureField::from_mask(&feature_mask(scene, feature, camera, screen, cols, rows), cols, rows, screen)?;
+    let placed = Lens { center: field.centroid, radius: field.equivalent_radius(), shape: Shape::Circle, ..lens.clone() };
+    let mut resolved = resolve(&placed, camera, screen, bounds);
+    resolved.shape = lens.shape.clone();
+    resolved.field = Some(Arc::new(field));
+    Some(resolved)
 }
 
 impl ResolvedLens {
+    /// Radial coordinate of offset `v` from the centre: the shape's, or for a feature
+    /// `lr + d` with `d` the signed distance to its silhouette.
+    pub fn radial(&self, v: Vec2) -> f32 {
+        match &self.field {
+            Some(field) => self.radius + field.distance_at(self.center + v),
+            None => self.shape.radial(v),
+        }
+    }
+
     /// The ray at lens coordinates `s` given the ray `below` of the lenses before this
     /// one; `None` where the lens shows nothing (outside a whole-view fisheye).
     pub fn apply(&self, camera: &Camera, screen: Screen, s: Vec2, below: Ray) -> Option<Ray> {
         let v = s - self.center;
-        let r = self.shape.radial(v);
+        let r = self.radial(v);
         match &self.effect {
             Effect::Magnifier(m) => {
                 let reach = if m.profile == super::Profile::Simple { self.radius } else { self.radius + self.border };

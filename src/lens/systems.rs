@@ -4,7 +4,7 @@ use bevy::camera::CameraUpdateSystems;
 use bevy::prelude::*;
 
 use super::spec::Lens;
-use super::stack::{MAX_LENSES, ResolvedLens, Screen, resolve};
+use super::stack::{MAX_LENSES, ResolvedLens, Screen, resolve_in};
 use crate::dataset::SceneRegions;
 use crate::region::{Camera as FocalCamera, Projection as FocalProjection};
 use crate::render::VolumeView;
@@ -40,27 +40,35 @@ pub fn focal_camera(transform: &GlobalTransform, projection: &Projection) -> Opt
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub struct LensOrder(pub u32);
 
+/// Resolves the lenses for every volume camera whose camera, image size, lenses or
+/// scene changed (a feature lens computes its silhouette then).
 pub fn resolve_view_lenses(
     lenses: Query<(Entity, &Lens, Option<&LensOrder>)>,
     mut views: Query<(&Camera, &GlobalTransform, &Projection, &mut ViewLenses), With<VolumeView>>,
     scene: Res<SceneRegions>,
+    mut last: Local<Vec<Lens>>,
 ) {
     let mut ordered: Vec<(Entity, &Lens, Option<&LensOrder>)> =
         lenses.iter().filter(|(_, l, _)| l.enabled && l.validate().is_ok()).collect();
     ordered.sort_by_key(|(e, _, o)| (o.map_or(u32::MAX, |o| o.0), *e));
     ordered.truncate(MAX_LENSES);
-    let bounds = scene.scene.bounding_sphere();
+    let current: Vec<Lens> = ordered.iter().map(|(_, l, _)| (*l).clone()).collect();
+    let lenses_changed = *last != current;
     for (camera, transform, projection, mut view) in &mut views {
         let (Some(cam), Some(size)) = (focal_camera(transform, projection), camera.physical_viewport_size()) else {
             continue;
         };
         let screen = Screen::new(size.x, size.y);
-        let resolved: Vec<ResolvedLens> = ordered.iter().map(|(_, l, _)| resolve(l, &cam, screen, bounds)).collect();
+        if !lenses_changed && !scene.is_changed() && view.camera == Some(cam) && view.screen == Some(screen) {
+            continue;
+        }
+        let resolved: Vec<ResolvedLens> = current.iter().filter_map(|l| resolve_in(l, &cam, screen, &scene.scene)).collect();
         let next = ViewLenses { lenses: resolved, camera: Some(cam), screen: Some(screen) };
         if *view != next {
             *view = next;
         }
     }
+    *last = current;
 }
 
 /// Replaces every lens entity of `world` with `lenses`, in stack order.

@@ -59,8 +59,7 @@ pub fn render_lensed(scene: &RenderScene, camera: &Camera, lenses: &[Lens], widt
         lens.validate().map_err(|e| format!("{} lens: {e}", lens.kind_name()))?;
     }
     let screen = Screen::new(width, height);
-    let bounds = scene.bounding_sphere();
-    let resolved: Vec<ResolvedLens> = lenses.iter().map(|l| crate::lens::stack::resolve(l, camera, screen, bounds)).collect();
+    let resolved: Vec<ResolvedLens> = lenses.iter().filter_map(|l| crate::lens::stack::resolve_in(l, camera, screen, scene)).collect();
     let regions = prepare(scene)?;
     let [r, g, b] = crate::transfer::color::srgb3_to_linear(scene.background);
     let bg = Vec4::new(r, g, b, 1.0);

@@ -24,6 +24,22 @@ pub struct RenderScene {
     pub lens_antialias: bool,
 }
 
+/// Equal when they show the same volumes (the same shared data, not equal copies) the
+/// same way.
+impl PartialEq for RenderScene {
+    fn eq(&self, other: &Self) -> bool {
+        self.volumes.len() == other.volumes.len()
+            && self.volumes.iter().zip(&other.volumes).all(|(a, b)| std::sync::Arc::ptr_eq(a, b))
+            && self.regions == other.regions
+            && self.appearances == other.appearances
+            && self.background == other.background
+            && self.light == other.light
+            && self.jitter == other.jitter
+            && self.skip_empty == other.skip_empty
+            && self.lens_antialias == other.lens_antialias
+    }
+}
+
 impl Default for RenderScene {
     fn default() -> Self {
         RenderScene {

@@ -110,6 +110,7 @@ pub mod lens_codes {
     pub const CIRCLE: u32 = 0;
     pub const SQUARE: u32 = 1;
     pub const POLYGON: u32 = 2;
+    pub const FEATURE: u32 = 3;
     /// `vec4`s of table or outline data per lens.
     pub const DATA_PER_LENS: usize = 16;
 }

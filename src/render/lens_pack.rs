@@ -1,22 +1,57 @@
-//! Packs a view's resolved lenses into its settings uniform (the lens systems decided
+//! Packs a view's resolved lenses into its settings uniform, and the silhouettes of its
+//! feature lenses into a storage buffer of their own (the lens systems decided
 //! everything; this only lays it out for `shaders/focal/lens.wgsl`).
 
+use bevy::prelude::*;
+use bevy::render::extract_component::ExtractComponent;
+use bevy::render::sync_component::SyncComponent;
 use glam::{UVec4, Vec4};
 
 use super::gpu_types::{GpuLens, GpuSettings, lens_codes};
 use crate::lens::shape::Shape;
 use crate::lens::stack::Effect;
-use crate::lens::{MAX_LENSES, ResolvedLens};
+use crate::lens::{MAX_LENSES, ResolvedLens, ViewLenses};
+
+/// The signed distance fields of a view's feature lenses, one after another in lens
+/// order (each lens's data holds its offset).
+#[derive(Component, Clone, Debug, Default, PartialEq)]
+pub struct GpuFeatureFields(pub Vec<f32>);
+
+/// The silhouettes of `lenses`, concatenated.
+pub fn feature_data(lenses: &[ResolvedLens]) -> Vec<f32> {
+    lenses.iter().take(MAX_LENSES).filter_map(|l| l.field.as_ref()).flat_map(|f| f.distance.iter().copied()).collect()
+}
+
+impl SyncComponent for ViewLenses {
+    type Target = GpuFeatureFields;
+}
+
+impl ExtractComponent for ViewLenses {
+    type QueryData = &'static ViewLenses;
+    type QueryFilter = With<Camera3d>;
+    type Out = GpuFeatureFields;
+
+    fn extract_component(lenses: &ViewLenses) -> Option<GpuFeatureFields> {
+        Some(GpuFeatureFields(feature_data(&lenses.lenses)))
+    }
+}
 
 /// Writes `lenses` into `settings` (at most [`MAX_LENSES`]).
 pub fn pack_lenses(settings: &mut GpuSettings, lenses: &[ResolvedLens]) {
     settings.lens_count = lenses.len().min(MAX_LENSES) as u32;
+    let mut field_offset = 0usize;
     for (i, lens) in lenses.iter().take(MAX_LENSES).enumerate() {
         let data = &mut settings.lens_data[i * lens_codes::DATA_PER_LENS..(i + 1) * lens_codes::DATA_PER_LENS];
-        let (shape, vertices) = match &lens.shape {
-            Shape::Circle => (lens_codes::CIRCLE, 0),
-            Shape::Square => (lens_codes::SQUARE, 0),
-            Shape::Polygon(points) => {
+        let (shape, vertices) = match (&lens.shape, &lens.field) {
+            (_, Some(field)) => {
+                data[0] = Vec4::new(field.cols as f32, field.rows as f32, field.origin.x, field.origin.y);
+                data[1] = Vec4::new(field.cell_x(), field.cell, field_offset as f32, 0.0);
+                field_offset += field.distance.len();
+                (lens_codes::FEATURE, 0)
+            }
+            (Shape::Circle | Shape::Feature(_), None) => (lens_codes::CIRCLE, 0),
+            (Shape::Square, None) => (lens_codes::SQUARE, 0),
+            (Shape::Polygon(points), None) => {
                 for (slot, pair) in data.iter_mut().zip(points.chunks(2)) {
                     let b = pair.get(1).copied().unwrap_or_default();
                     *slot = Vec4::new(pair[0].x, pair[0].y, b.x, b.y);

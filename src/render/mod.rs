@@ -72,7 +72,11 @@ impl Plugin for VolumeRenderPlugin {
         let progress = RenderProgress::default();
         app.init_resource::<GpuLimits>()
             .insert_resource(progress.clone())
-            .add_plugins((ExtractComponentPlugin::<VolumeView>::default(), UniformComponentPlugin::<GpuSettings>::default()))
+            .add_plugins((
+                ExtractComponentPlugin::<VolumeView>::default(),
+                ExtractComponentPlugin::<crate::lens::ViewLenses>::default(),
+                UniformComponentPlugin::<GpuSettings>::default(),
+            ))
             .add_systems(PostUpdate, (extract::request_depth_binding, fit_datasets.before(crate::dataset::RegionSystems::Collect)));
 
         let Some(render_app) = app.get_sub_app_mut(RenderApp) else {

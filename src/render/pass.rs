@@ -8,6 +8,7 @@ use bevy::render::renderer::{RenderContext, ViewQuery};
 use bevy::render::view::{ViewDepthTexture, ViewTarget, ViewUniformOffset, ViewUniforms};
 
 use super::gpu_types::GpuSettings;
+use super::lens_pack::GpuFeatureFields;
 use super::pipeline::{RaycastPipeline, RaycastPipelineId};
 use super::upload::GpuScene;
 
@@ -20,6 +21,7 @@ pub fn raycast_pass(
         &DynamicUniformIndex<GpuSettings>,
         &RaycastPipelineId,
         Option<&ExtractedCamera>,
+        Option<&GpuFeatureFields>,
     )>,
     pipeline: Res<RaycastPipeline>,
     cache: Res<PipelineCache>,
@@ -29,7 +31,7 @@ pub fn raycast_pass(
     progress: Res<super::RenderProgress>,
     mut ctx: RenderContext,
 ) {
-    let (target, depth, view_offset, settings_index, pipeline_id, camera) = view.into_inner();
+    let (target, depth, view_offset, settings_index, pipeline_id, camera, fields) = view.into_inner();
     if scene.region_count == 0 || !scene.ready() {
         return;
     }
@@ -43,6 +45,14 @@ pub fn raycast_pass(
     else {
         return;
     };
+    // The feature lenses' silhouettes (one unused value when there are none).
+    let fields: &[f32] = fields.map(|f| f.0.as_slice()).filter(|f| !f.is_empty()).unwrap_or(&[0.0]);
+    let field_bytes: Vec<u8> = fields.iter().flat_map(|v| v.to_le_bytes()).collect();
+    let field_buffer = ctx.render_device().create_buffer_with_data(&BufferInitDescriptor {
+        label: Some("focal feature fields"),
+        contents: &field_bytes,
+        usage: BufferUsages::STORAGE,
+    });
     let bind_group = ctx.render_device().create_bind_group(
         "focal_raycast_bind_group",
         &cache.get_bind_group_layout(&pipeline.layout),
@@ -58,6 +68,7 @@ pub fn raycast_pass(
             &atlases.bricks,
             &pipeline.sampler,
             depth.view(),
+            field_buffer.as_entire_binding(),
         )),
     );
     let mut pass = ctx.command_encoder().begin_render_pass(&RenderPassDescriptor {

@@ -39,6 +39,7 @@ pub fn init_pipeline(mut commands: Commands, device: Res<RenderDevice>, fullscre
                 texture_3d(TextureSampleType::Uint),
                 sampler(SamplerBindingType::Filtering),
                 texture_depth_2d(),
+                storage_buffer_read_only_sized(false, None),
             ),
         ),
     );

@@ -270,7 +270,9 @@ fn lens_settings(ui: &mut egui::Ui, lens: &mut Lens) {
         Shape::Circle => "circle",
         Shape::Square => "square",
         Shape::Polygon(_) => "drawn",
+        Shape::Feature(_) => "feature",
     };
+    let magnifier = matches!(lens.kind, LensKind::Magnifier { .. });
     let square_ok = !matches!(lens.kind, LensKind::Angular { .. });
     egui::ComboBox::from_label("shape").selected_text(shape_name).show_ui(ui, |ui| {
         if ui.selectable_label(shape_name == "circle", "circle").clicked() {
@@ -279,8 +281,18 @@ fn lens_settings(ui: &mut egui::Ui, lens: &mut Lens) {
         if square_ok && ui.selectable_label(shape_name == "square", "square").clicked() {
             lens.shape = Shape::Square;
         }
+        if magnifier && ui.selectable_label(shape_name == "feature", "feature (a label)").clicked() {
+            lens.shape = Shape::Feature(crate::lens::feature::FeatureRef { label: 1, region: None });
+        }
     });
-    if !matches!(lens.shape, Shape::Polygon(_)) {
+    if let Shape::Feature(feature) = &mut lens.shape {
+        ui.horizontal(|ui| {
+            ui.label("label");
+            ui.add(egui::DragValue::new(&mut feature.label).range(1..=65535));
+            ui.label(RichText::new("of the first label volume shown").weak());
+        });
+    }
+    if !matches!(lens.shape, Shape::Polygon(_) | Shape::Feature(_)) {
         ui.add(egui::Slider::new(&mut lens.radius, 0.02..=1.5).text("radius"));
     }
     match &mut lens.kind {
@@ -411,7 +423,8 @@ pub fn overlay(ctx: &egui::Context, free: Rect, params: &mut LensParams, regions
 
     if params.ui.show_outlines {
         for (e, lens, _) in params.ordered() {
-            if matches!(lens.kind, LensKind::Angular { whole_view: true, .. }) {
+            // A whole-view fisheye has no outline; a feature lens's is its feature.
+            if matches!(lens.kind, LensKind::Angular { whole_view: true, .. }) || matches!(lens.shape, Shape::Feature(_)) {
                 continue;
             }
             let selected = params.ui.selected == Some(e);

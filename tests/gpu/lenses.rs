@@ -256,3 +256,19 @@ pub fn antialiasing_removes_moire_where_lenses_compress(gpu: &mut Gpu) {
     let c = render_lensed(&RenderScene::single(v, a), &cam, std::slice::from_ref(&lens), SIZE, SIZE).unwrap().to_image().unwrap();
     assert_matches("lens_antialiased_pattern", &images[1], &c);
 }
+
+pub fn feature_lens_matches_the_reference(gpu: &mut Gpu) {
+    // The ventricles of the labelled head phantom shape the lens (Wang fig. 8).
+    let (v, a) = labelled_head();
+    let ventricles = focal::lens::feature::FeatureRef { label: phantom::head::label::VENTRICLES as u32, region: None };
+    for ortho in [false, true] {
+        let cam = framed(&v, View::Anterior, ortho);
+        let lens = Lens { shape: Shape::Feature(ventricles.clone()), ..Lens::magnifier(Vec2::ZERO, 0.3, 0.15, 2.5) };
+        let g = show_lensed(gpu, v.clone(), a.clone(), &cam, std::slice::from_ref(&lens));
+        let c = cpu_lensed(v.clone(), a.clone(), &cam, std::slice::from_ref(&lens));
+        let plain = gpu.show(v.clone(), a.clone(), &cam);
+        assert_matches(&format!("lens_feature{}", if ortho { "_ortho" } else { "" }), &g, &c);
+        let changed = g.pixels().zip(plain.pixels()).filter(|(p, q)| (0..3).any(|k| p[k].abs_diff(q[k]) > 10)).count();
+        assert!(changed > 50, "the feature lens changed only {changed} pixels");
+    }
+}

@@ -1,0 +1,348 @@
+//! The feature lens (Wang et al. 2005, §3.2): a magnifier whose focus region is a
+//! segmented feature as projected in the current view. Rays through the feature's
+//! projection bend to the virtual focal point, rays within `lb` of it bend by their
+//! distance `d` to it, the others go straight — the drawn-outline magnifier with the
+//! outline replaced by the feature's silhouette.
+//!
+//! Per view and frame:
+//! 1. **Feature mask** on a coarse grid over the image ([`FIELD_ROWS`] rows): a cell is
+//!    inside when the camera's own ray through its centre meets a voxel of the feature
+//!    (a label of a label volume), found by marching the label volume with nearest
+//!    sampling every half voxel.
+//! 2. **Distance transform** of the mask: the exact Euclidean distance of every cell to
+//!    the nearest inside cell and, inside, to the nearest outside cell (Felzenszwalb and
+//!    Huttenlocher's separable lower-envelope algorithm), turned into a signed distance
+//!    to the silhouette in lens units (half a cell off the cell centres).
+//! 3. The lens centre is the silhouette's centroid (the central ray and `F` go through
+//!    it) and its radius the equivalent radius `lr = √(area/π)`; the radial coordinate is
+//!    `r = lr + d(s)`, as for a drawn outline ([`super::shape`]).
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::stack::Screen;
+use crate::region::{Camera, RenderScene};
+use crate::volume::sample::VolumeSampler;
+
+/// Rows of the feature grid (columns follow the aspect ratio).
+pub const FIELD_ROWS: u32 = 96;
+
+/// Which feature a lens follows.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FeatureRef {
+    /// The label.
+    pub label: u32,
+    /// Index of the region (visible dataset, in order) holding the label volume; by
+    /// default the first region shown with labels.
+    #[serde(default)]
+    pub region: Option<usize>,
+}
+
+/// A feature's silhouette in one view: its signed distance field on the grid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FeatureField {
+    pub cols: u32,
+    pub rows: u32,
+    /// Lens coordinates of the centre of cell (0, 0) (top left) and the cell size.
+    pub origin: Vec2,
+    pub cell: f32,
+    /// Aspect ratio of the screen the grid covers.
+    pub aspect: f32,
+    /// Signed distance to the silhouette per cell, lens units, negative inside (row
+    /// major, top row first).
+    pub distance: Vec<f32>,
+    /// Centroid of the silhouette (lens units) and its area (lens units²).
+    pub centroid: Vec2,
+    pub area: f32,
+}
+
+/// Squared Euclidean distance transform in one dimension (lower envelope of parabolas).
+fn edt_1d(f: &[f32], out: &mut [f32]) {
+    let n = f.len();
+    let mut v = vec![0usize; n];
+    let mut z = vec![0f32; n + 1];
+    let mut k = 0usize;
+    z[0] = f32::NEG_INFINITY;
+    z[1] = f32::INFINITY;
+    let mut first = None;
+    for q in 0..n {
+        if !f[q].is_finite() {
+            continue;
+        }
+        if first.is_none() {
+            first = Some(q);
+            v[0] = q;
+            continue;
+        }
+        loop {
+            let p = v[k];
+            let s = ((f[q] + (q * q) as f32) - (f[p] + (p * p) as f32)) / (2.0 * (q as f32 - p as f32));
+            if s <= z[k] && k > 0 {
+                k -= 1;
+                continue;
+            }
+            if s <= z[k] {
+                // k == 0 and the new parabola dominates everywhere.
+                v[0] = q;
+                z[1] = f32::INFINITY;
+                break;
+            }
+            k += 1;
+            v[k] = q;
+            z[k] = s;
+            z[k + 1] = f32::INFINITY;
+            break;
+        }
+    }
+    if first.is_none() {
+        out.iter_mut().for_each(|o| *o = f32::INFINITY);
+        return;
+    }
+    k = 0;
+    for (q, o) in out.iter_mut().enumerate() {
+        while z[k + 1] < q as f32 {
+            k += 1;
+        }
+        let p = v[k];
+        let d = q as f32 - p as f32;
+        *o = d * d + f[p];
+    }
+}
+
+/// Euclidean distance (in cells) from every cell to the nearest cell where `seed` holds
+/// (infinity when there is none).
+pub fn distance_transform(seed: &[bool], cols: usize, rows: usize) -> Vec<f32> {
+    let mut g: Vec<f32> = seed.iter().map(|&s| if s { 0.0 } else { f32::INFINITY }).collect();
+    let mut line = vec![0f32; cols.max(rows)];
+    let mut out = vec![0f32; cols.max(rows)];
+    for x in 0..cols {
+        for y in 0..rows {
+            line[y] = g[y * cols + x];
+        }
+        edt_1d(&line[..rows], &mut out[..rows]);
+        for y in 0..rows {
+            g[y * cols + x] = out[y];
+        }
+    }
+    for y in 0..rows {
+        line[..cols].copy_from_slice(&g[y * cols..(y + 1) * cols]);
+        edt_1d(&line[..cols], &mut out[..cols]);
+        g[y * cols..(y + 1) * cols].copy_from_slice(&out[..cols]);
+    }
+    g.into_iter().map(f32::sqrt).collect()
+}
+
+impl FeatureField {
+    /// The field of a mask over a screen (`cols × rows` cells covering the image); `None`
+    /// when the mask is empty.
+    pub fn from_mask(mask: &[bool], cols: u32, rows: u32, screen: Screen) -> Option<FeatureField> {
+        let (c, r) = (cols as usize, rows as usize);
+        let inside = mask.iter().filter(|&&m| m).count();
+        if inside == 0 {
+            return None;
+        }
+        // Cells are square in lens units when cols = rows·aspect ([`grid_size`]).
+        let step = Vec2::new(2.0 * screen.aspect() / cols as f32, 2.0 / rows as f32);
+        let cell = step.y;
+        let origin = Vec2::new(-screen.aspect() + 0.5 * step.x, 1.0 - 0.5 * step.y);
+        let to_in = distance_transform(mask, c, r);
+        let outside: Vec<bool> = mask.iter().map(|m| !m).collect();
+        let to_out = distance_transform(&outside, c, r);
+        let distance = mask
+            .iter()
+            .enumerate()
+            .map(|(i, &m)| if m { -(to_out[i] - 0.5) * cell } else { (to_in[i] - 0.5) * cell })
+            .collect();
+        let mut sum = Vec2::ZERO;
+        for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
+            sum += origin + Vec2::new((i % c) as f32 * step.x, -((i / c) as f32) * step.y);
+        }
+        Some(FeatureField {
+            cols,
+            rows,
+            origin,
+            cell: step.y,
+            aspect: screen.aspect(),
+            distance,
+            centroid: sum / inside as f32,
+            area: inside as f32 * step.x * step.y,
+        })
+    }
+
+    /// Equivalent radius `√(area/π)`.
+    pub fn equivalent_radius(&self) -> f32 {
+        (self.area / std::f32::consts::PI).sqrt()
+    }
+
+    /// Horizontal cell size (lens units).
+    pub fn cell_x(&self) -> f32 {
+        2.0 * self.aspect / self.cols as f32
+    }
+
+    /// Signed distance at lens coordinates `s` (bilinear between cell centres; beyond
+    /// the grid, the edge value plus the distance to the edge).
+    pub fn distance_at(&self, s: Vec2) -> f32 {
+        let cx = self.cell_x();
+        let gx = (s.x - self.origin.x) / cx;
+        let gy = (self.origin.y - s.y) / self.cell;
+        let (maxx, maxy) = ((self.cols - 1) as f32, (self.rows - 1) as f32);
+        let (x, y) = (gx.clamp(0.0, maxx), gy.clamp(0.0, maxy));
+        let beyond = Vec2::new((gx - x) * cx, (gy - y) * self.cell).length();
+        let (x0, y0) = (x.floor() as usize, y.floor() as usize);
+        let (x1, y1) = ((x0 + 1).min(self.cols as usize - 1), (y0 + 1).min(self.rows as usize - 1));
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        let at = |x: usize, y: usize| self.distance[y * self.cols as usize + x];
+        let top = at(x0, y0) + (at(x1, y0) - at(x0, y0)) * fx;
+        let bottom = at(x0, y1) + (at(x1, y1) - at(x0, y1)) * fx;
+        top + (bottom - top) * fy + beyond
+    }
+}
+
+/// Grid size for a screen: [`FIELD_ROWS`] rows and square cells.
+pub fn grid_size(screen: Screen) -> (u32, u32) {
+    ((FIELD_ROWS as f32 * screen.aspect()).round().max(1.0) as u32, FIELD_ROWS)
+}
+
+/// The region showing a feature: the one named, or the first shown with labels.
+fn feature_region(scene: &RenderScene, feature: &FeatureRef) -> Option<usize> {
+    let labels = |i: &usize| {
+        scene.appearances.get(scene.regions[*i].appearance).is_some_and(|a| matches!(a.lookup, crate::region::Lookup::Labels(_)))
+    };
+    match feature.region {
+        Some(i) => (i < scene.regions.len()).then_some(i),
+        None => (0..scene.regions.len()).find(labels),
+    }
+}
+
+/// The feature mask of `feature` seen by `camera` on a `cols × rows` grid over `screen`.
+pub fn feature_mask(scene: &RenderScene, feature: &FeatureRef, camera: &Camera, screen: Screen, cols: u32, rows: u32) -> Vec<bool> {
+    let Some(region) = feature_region(scene, feature).map(|i| &scene.regions[i]) else {
+        return vec![false; (cols * rows) as usize];
+    };
+    let Some(volume) = scene.volumes.get(region.volume) else { return vec![false; (cols * rows) as usize] };
+    let sampler = VolumeSampler::of(volume);
+    let label = feature.label;
+    // Half a voxel in world units along the shortest axis.
+    let step = 0.5 * volume.grid.min_spacing();
+    (0..rows * cols)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (i % cols, i / cols);
+            let px = (x as f32 + 0.5) / cols as f32 * screen.width;
+            let py = (y as f32 + 0.5) / rows as f32 * screen.height;
+            let ray = camera.ray(px, py, screen.width as u32, screen.height as u32);
+            let Some((t0, t1)) = region.intersect(ray.origin, ray.dir) else { return false };
+            let mut t = t0.max(0.0) + 0.5 * step;
+            while t < t1 {
+                let q: Vec3 = region.world_to_voxel.transform_point3(ray.at(t));
+                if sampler.nearest(q) as u32 == label {
+                    return true;
+                }
+                t += step;
+            }
+            false
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distance_transform_is_euclidean() {
+        // One seed in a 5×4 grid: distances are Euclidean by hand.
+        let mut seed = vec![false; 20];
+        seed[6] = true; // (1, 1)
+        let d = distance_transform(&seed, 5, 4);
+        assert_eq!(d[6], 0.0);
+        assert!((d[0] - 2f32.sqrt()).abs() < 1e-6);
+        assert!((d[19] - (9.0f32 + 4.0).sqrt()).abs() < 1e-6, "{}", d[19]);
+        assert!((d[9] - (9.0f32 + 0.0).sqrt()).abs() < 1e-6);
+        // Two seeds: the nearer one counts.
+        seed[18] = true; // (3, 3)
+        let d = distance_transform(&seed, 5, 4);
+        assert!((d[19] - 1.0).abs() < 1e-6);
+        // Brute force on a random mask.
+        let mask: Vec<bool> = (0..77u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 28) == 3).collect();
+        let d = distance_transform(&mask, 11, 7);
+        for (i, &got) in d.iter().enumerate() {
+            let want = (0..77)
+                .filter(|&j| mask[j])
+                .map(|j| {
+                    let (dx, dy) = ((i % 11) as f32 - (j % 11) as f32, (i / 11) as f32 - (j / 11) as f32);
+                    (dx * dx + dy * dy).sqrt()
+                })
+                .fold(f32::INFINITY, f32::min);
+            assert!((got - want).abs() < 1e-5 || (want.is_infinite() && got.is_infinite()), "cell {i}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn a_disc_gives_its_centroid_radius_and_distances() {
+        // A disc of radius 0.4 lens units centred at (0.2, -0.1) on a square screen.
+        let screen = Screen::new(200, 200);
+        let (cols, rows) = grid_size(screen);
+        let centre = Vec2::new(0.2, -0.1);
+        let cell = 2.0 / rows as f32;
+        let mask: Vec<bool> = (0..cols * rows)
+            .map(|i| {
+                let p = Vec2::new(-1.0 + (i % cols) as f32 * cell + 0.5 * cell, 1.0 - (i / cols) as f32 * cell - 0.5 * cell);
+                (p - centre).length() < 0.4
+            })
+            .collect();
+        let f = FeatureField::from_mask(&mask, cols, rows, screen).unwrap();
+        assert!((f.centroid - centre).length() < 0.01, "{}", f.centroid);
+        assert!((f.equivalent_radius() - 0.4).abs() < 0.01, "{}", f.equivalent_radius());
+        // Distances to the silhouette, inside and out, within a cell.
+        for (s, want) in [(centre, -0.4), (centre + Vec2::new(0.6, 0.0), 0.2), (centre + Vec2::new(0.0, 0.3), -0.1), (Vec2::new(-0.9, 0.9), 0.0)] {
+            let want = if want == 0.0 { (Vec2::new(-0.9, 0.9) - centre).length() - 0.4 } else { want };
+            let d = f.distance_at(s);
+            assert!((d - want).abs() < 1.5 * cell, "{s}: {d} vs {want}");
+        }
+        assert!(FeatureField::from_mask(&vec![false; mask.len()], cols, rows, screen).is_none());
+    }
+
+    #[test]
+    fn a_feature_lens_bends_the_rays_through_its_silhouette() {
+        use crate::lens::stack::{lens_ray, resolve_in};
+        use crate::lens::{Lens, Shape};
+        use crate::scene::load::{camera, load_datasets, render_scene, visible_bounds};
+        let file = crate::scene::SceneFile::parse("(datasets: [(source: PhantomLabels(resolution: 48), appearance: (labels: Some(())))])", "t").unwrap();
+        let datasets = load_datasets(&file, std::path::Path::new(".")).unwrap();
+        let scene = render_scene(&datasets, &file);
+        let cam = camera(&file.camera, visible_bounds(&datasets), 1.0);
+        let screen = Screen::new(120, 120);
+        let ventricles = FeatureRef { label: crate::volume::phantom::head::label::VENTRICLES as u32, region: None };
+        let lens = Lens { shape: Shape::Feature(ventricles), ..Lens::magnifier(Vec2::ZERO, 0.3, 0.15, 2.0) };
+        let resolved = resolve_in(&lens, &cam, screen, &scene).expect("the ventricles are in view");
+        let field = resolved.field.clone().unwrap();
+        assert!(field.area > 0.005 && field.area < 1.0, "{}", field.area);
+        assert_eq!(resolved.center, field.centroid);
+        // A circular magnifier with the same centre covering the whole image: inside the
+        // silhouette the feature lens bends rays exactly as its focus region does.
+        let cover = crate::lens::stack::resolve(&Lens::magnifier(field.centroid, 4.0, 0.0, 2.0), &cam, screen, scene.bounding_sphere());
+        let (mut inside, mut outside) = (0, 0);
+        for py in (0..120).step_by(3) {
+            for px in (0..120).step_by(3) {
+                let (x, y) = (px as f32 + 0.5, py as f32 + 0.5);
+                let d = field.distance_at(screen.to_lens(x, y));
+                let ray = lens_ray(&cam, screen, std::slice::from_ref(&resolved), x, y).unwrap();
+                if d < -0.01 {
+                    let focus = lens_ray(&cam, screen, std::slice::from_ref(&cover), x, y).unwrap();
+                    assert!((ray.dir - focus.dir).length() < 1e-5, "({px}, {py})");
+                    inside += 1;
+                } else if d > resolved.border + 0.01 {
+                    assert_eq!(ray, cam.ray(x, y, 120, 120), "({px}, {py})");
+                    outside += 1;
+                }
+            }
+        }
+        assert!(inside > 5 && outside > 100, "{inside} {outside}");
+        // A label nobody has: no lens.
+        let none = Lens { shape: Shape::Feature(FeatureRef { label: 200, region: None }), ..lens };
+        assert!(resolve_in(&none, &cam, screen, &scene).is_none());
+    }
+}
