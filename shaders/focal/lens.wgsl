@@ -224,16 +224,16 @@ fn lens_ray(uv: vec2<f32>) -> Ray {
     return ray;
 }
 
-// Anti-aliasing (reference: src/lens/antialias.rs, eq. 4). The rays of a pixel and its
-// right and lower neighbours lie dx = Δo_x + Δd_x·t and dy = Δo_y + Δd_y·t apart at
-// parameter t; the footprint's longest extent is the largest singular value of
-// [dx dy], and the mip level log2(1/mf) with mf its plain over its lensed value at the
-// same view depth.
+// Anti-aliasing (reference: src/lens/antialias.rs, eq. 4). A ray by view depth z is the
+// line x(z) = p + q·z; the rays of a pixel and its right and lower neighbours lie
+// Δp_x + Δq_x·z and Δp_y + Δq_y·z apart at depth z; the footprint's longest extent is
+// the largest singular value of that pair, and the mip level log2(1/mf) with mf its
+// plain over its lensed value.
 struct Spread {
-    ox: vec3<f32>,
-    dx: vec3<f32>,
-    oy: vec3<f32>,
-    dy: vec3<f32>,
+    px: vec3<f32>,
+    qx: vec3<f32>,
+    py: vec3<f32>,
+    qy: vec3<f32>,
     depth0: f32,
     depth_per_t: f32,
 }
@@ -242,22 +242,23 @@ var<private> lensed_spread: Spread;
 var<private> plain_spread: Spread;
 var<private> has_footprint: bool = false;
 
-fn spread_of(r: Ray, rx: Ray, ry: Ray) -> Spread {
-    let d = normalize(r.dir);
-    let forward = -view.world_from_view[2].xyz;
-    return Spread(
-        rx.origin - r.origin,
-        normalize(rx.dir) - d,
-        ry.origin - r.origin,
-        normalize(ry.dir) - d,
-        dot(r.origin - view.world_position, forward),
-        dot(d, forward),
-    );
+// The line of a ray by view depth: (p, q) with x(z) = p + q·z.
+fn depth_line(r: Ray, forward: vec3<f32>) -> array<vec3<f32>, 2> {
+    let q = r.dir / max(dot(r.dir, forward), 1e-6);
+    return array<vec3<f32>, 2>(r.origin - q * dot(r.origin - view.world_position, forward), q);
 }
 
-fn spread_extent(s: Spread, t: f32) -> f32 {
-    let x = s.ox + s.dx * t;
-    let y = s.oy + s.dy * t;
+fn spread_of(r: Ray, rx: Ray, ry: Ray) -> Spread {
+    let forward = -view.world_from_view[2].xyz;
+    let a = depth_line(r, forward);
+    let b = depth_line(rx, forward);
+    let c = depth_line(ry, forward);
+    return Spread(b[0] - a[0], b[1] - a[1], c[0] - a[0], c[1] - a[1], dot(r.origin - view.world_position, forward), dot(normalize(r.dir), forward));
+}
+
+fn spread_extent(s: Spread, z: f32) -> f32 {
+    let x = s.px + s.qx * z;
+    let y = s.py + s.qy * z;
     let a = dot(x, x);
     let b = dot(x, y);
     let c = dot(y, y);
@@ -282,9 +283,8 @@ fn lens_footprint(uv: vec2<f32>, ray: Ray) {
 // Mip level at ray parameter t.
 fn lod_at(t: f32) -> f32 {
     let depth = lensed_spread.depth0 + lensed_spread.depth_per_t * t;
-    let tp = (depth - plain_spread.depth0) / max(plain_spread.depth_per_t, 1e-6);
-    let lensed = spread_extent(lensed_spread, t);
-    let plain = spread_extent(plain_spread, tp);
+    let lensed = spread_extent(lensed_spread, depth);
+    let plain = spread_extent(plain_spread, depth);
     if lensed > 0.0 && plain > 0.0 {
         return clamp(log2(lensed / plain), 0.0, 3.0);
     }
@@ -292,7 +292,8 @@ fn lod_at(t: f32) -> f32 {
 }
 
 // Restricts the footprint to the ray's interval [t0, t1]: the lensed extent is convex in
-// t (the largest singular value of a matrix affine in t) and the plain one affine, so
+// the depth (the largest singular value of a matrix affine in it) and the plain one
+// affine, and the depth is affine in t, so
 // their ratio is quasi-convex and its maximum over the interval lies at an end. Level 0
 // at both ends means level 0 throughout: the per-sample work is skipped (exactly).
 fn restrict_footprint(t0: f32, t1: f32) {

@@ -7,9 +7,12 @@
 //!
 //! blending the two nearest levels; where the lens magnifies, `L = 0`.
 //!
-//! `mf` is measured per sample with ray differentials: the rays of a pixel and of its
-//! right and lower neighbours are `Δ_x = Δo_x + Δd_x·t` and `Δ_y = Δo_y + Δd_y·t` apart
-//! at ray parameter `t` (`Δ` of origins and unit directions). A lens border compresses
+//! `mf` is measured per sample with ray differentials. Each ray is written by its view
+//! depth `z` (distance along the camera's forward axis): `x(z) = p + q·z` with
+//! `q = d/(d·f)` and `p = o − q·z(o)` — the same line gives the same `p, q` wherever its
+//! origin lies (a bent ray starts on the lens plane, a straight one at the eye). The rays
+//! of a pixel and of its right and lower neighbours are `Δ_x = Δp_x + Δq_x·z` and
+//! `Δ_y = Δp_y + Δq_y·z` apart at depth `z`. A lens border compresses
 //! in one direction (radially) while it stretches in the other, so `mf` is the
 //! magnification in the most compressed direction: the pixel footprint's longest
 //! extent, the largest singular value `σ` of `[Δ_x Δ_y]`,
@@ -19,8 +22,8 @@
 //! [`super::local_magnification`], would leave the radial moiré in place.) The shader
 //! computes the same differentials once per pixel and the level at every sample.
 //!
-//! The lensed extent is convex in `t` (the largest singular value of a matrix affine in
-//! `t`) and the plain one affine in `t` (rays from one eye, or parallel), so their ratio
+//! The lensed extent is convex in `z` (the largest singular value of a matrix affine in
+//! `z`) and the plain one affine in `z` (rays from one eye, or parallel), so their ratio
 //! is quasi-convex: over a ray's interval its maximum lies at an end. Where the level is
 //! 0 at both ends of the interval it is 0 throughout, and the shader skips the
 //! per-sample work for that pixel (an exact shortcut; [`Footprint::level_free`]).
@@ -33,7 +36,7 @@ use crate::region::{Camera, Ray};
 /// Differentials of a pixel's rays and the map from ray parameter to view depth.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Spread {
-    /// `Δo_x, Δd_x, Δo_y, Δd_y`.
+    /// `Δp_x, Δq_x, Δp_y, Δq_y` (see the module docs).
     pub deltas: [Vec3; 4],
     /// View depth of the ray origin and its change per unit `t`.
     pub depth0: f32,
@@ -49,19 +52,21 @@ pub fn largest_singular_value(x: Vec3, y: Vec3) -> f32 {
 impl Spread {
     /// The spread of the rays `r` (the pixel), `rx` and `ry` (its neighbours).
     pub fn of(camera: &Camera, r: Ray, rx: Ray, ry: Ray) -> Spread {
-        let d = r.dir.normalize_or_zero();
         let fwd = camera.forward();
-        Spread {
-            deltas: [rx.origin - r.origin, rx.dir.normalize_or_zero() - d, ry.origin - r.origin, ry.dir.normalize_or_zero() - d],
-            depth0: (r.origin - camera.position).dot(fwd),
-            depth_per_t: d.dot(fwd),
-        }
+        // The line of a ray by view depth: x(z) = p + q·z.
+        let line = |ray: Ray| {
+            let q = ray.dir / ray.dir.dot(fwd).max(1e-6);
+            (ray.origin - q * (ray.origin - camera.position).dot(fwd), q)
+        };
+        let ((p, q), (px, qx), (py, qy)) = (line(r), line(rx), line(ry));
+        let d = r.dir.normalize_or_zero();
+        Spread { deltas: [px - p, qx - q, py - p, qy - q], depth0: (r.origin - camera.position).dot(fwd), depth_per_t: d.dot(fwd) }
     }
 
-    /// Longest extent of the pixel footprint at ray parameter `t`.
-    pub fn extent(&self, t: f32) -> f32 {
-        let [ox, dx, oy, dy] = self.deltas;
-        largest_singular_value(ox + dx * t, oy + dy * t)
+    /// Longest extent of the pixel footprint at view depth `z`.
+    pub fn extent(&self, z: f32) -> f32 {
+        let [px, qx, py, qy] = self.deltas;
+        largest_singular_value(px + qx * z, py + qy * z)
     }
 
     /// Ray parameter at view depth `z`.
@@ -93,8 +98,8 @@ impl Footprint {
     /// lensed ray.
     pub fn magnification(&self, t: f32) -> f32 {
         let depth = self.lensed.depth0 + self.lensed.depth_per_t * t;
-        let plain = self.plain.extent(self.plain.t_at_depth(depth));
-        let lensed = self.lensed.extent(t);
+        let plain = self.plain.extent(depth);
+        let lensed = self.lensed.extent(depth);
         if lensed <= 0.0 { f32::INFINITY } else { plain / lensed }
     }
 
@@ -225,6 +230,21 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    #[test]
+    fn rays_starting_elsewhere_on_the_same_line_do_not_count_as_spread() {
+        // At the outer edge of a magnifier's border the bent rays start on the lens
+        // plane, their straight neighbours at the eye: same lines, no compression.
+        let screen = Screen::new(200, 200);
+        for projection in [Projection::Perspective { fov_y: 0.6 }, Projection::Orthographic { height: 200.0 }] {
+            let cam = Camera::look_at(Vec3::new(0.0, 0.0, 500.0), Vec3::ZERO, Vec3::Y, projection);
+            let resolved = [resolve(&Lens::magnifier(Vec2::ZERO, 0.4, 0.3, 3.0), &cam, screen, (Vec3::ZERO, 100.0))];
+            // The outer edge at 70 pixels from the centre: pixel 169.5 bends, 170.5 does not.
+            let f = Footprint::new(&cam, screen, &resolved, 169.5, 100.0).unwrap();
+            let t = f.lensed.t_at_depth(500.0);
+            assert!(f.level(t, 3.0) < 0.1, "{projection:?}: level {}", f.level(t, 3.0));
         }
     }
 }
