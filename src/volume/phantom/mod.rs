@@ -4,7 +4,9 @@
 //!   vessels, a lesion and tiny calcifications, plus a matching label volume;
 //! - [`engine`]: a mechanical part with bores, liners and closed internal cavities;
 //! - [`sphere`]: a ball with a one-voxel linear edge ramp whose 0.5 iso-surface is at an
-//!   exactly known radius, for tests.
+//!   exactly known radius, for tests;
+//! - [`lattice`]: a cubic lattice of thin bars, fine detail that shows magnification
+//!   and aliasing (lens tests and figures).
 //!
 //! All are painted from signed-distance shapes ([`shapes`]) in parallel; 256³ takes a
 //! fraction of a second (see `benches/volume.rs`).
@@ -28,16 +30,18 @@ pub enum Phantom {
     Head,
     Engine,
     Sphere,
+    Lattice,
 }
 
 impl Phantom {
-    pub const ALL: [Phantom; 3] = [Phantom::Head, Phantom::Engine, Phantom::Sphere];
+    pub const ALL: [Phantom; 4] = [Phantom::Head, Phantom::Engine, Phantom::Sphere, Phantom::Lattice];
 
     pub fn name(self) -> &'static str {
         match self {
             Phantom::Head => "head",
             Phantom::Engine => "engine",
             Phantom::Sphere => "sphere",
+            Phantom::Lattice => "lattice",
         }
     }
 
@@ -48,6 +52,7 @@ impl Phantom {
             Phantom::Head => Ok(head::generate(n)?.ct),
             Phantom::Engine => engine::generate(n),
             Phantom::Sphere => sphere(n, n as f32 * 0.35),
+            Phantom::Lattice => lattice(n),
         }
     }
 }
@@ -59,7 +64,7 @@ impl FromStr for Phantom {
         Phantom::ALL
             .into_iter()
             .find(|p| p.name() == s.trim().to_ascii_lowercase())
-            .ok_or_else(|| format!("unknown phantom '{s}' (expected head, engine or sphere)"))
+            .ok_or_else(|| format!("unknown phantom '{s}' (expected head, engine, sphere or lattice)"))
     }
 }
 
@@ -80,6 +85,31 @@ pub fn sphere(n: u32, radius: f32) -> Result<Volume, String> {
         details: vec![("phantom".into(), format!("sphere r = {radius} voxels"))],
     };
     Volume::new("sphere phantom", grid, Voxels::U8(codes), ValueMap::IDENTITY, source)
+}
+
+/// A cubic lattice in an `n³` unit-spacing grid: bars along the three axes, one every
+/// `period = max(4, n/24)` voxels, `⌈period/3⌉` voxels thick (8-bit 255 in the bars, 0
+/// between them).
+pub fn lattice(n: u32) -> Result<Volume, String> {
+    let n = n.max(4);
+    let period = (n / 24).max(4);
+    let width = period.div_ceil(3);
+    let grid = Grid::centered(UVec3::splat(n), Vec3::ONE);
+    let on = |c: u32| c % period < width;
+    let codes = (0..n * n * n)
+        .map(|i| {
+            let (x, y, z) = (i % n, (i / n) % n, i / (n * n));
+            let axes = on(x) as u32 + on(y) as u32 + on(z) as u32;
+            if axes >= 2 { 255 } else { 0 }
+        })
+        .collect();
+    let source = Source {
+        format: "phantom".into(),
+        path: None,
+        sample_type: "uint8".into(),
+        details: vec![("phantom".into(), format!("lattice, bars every {period} voxels, {width} thick"))],
+    };
+    Volume::new("lattice phantom", grid, Voxels::U8(codes), ValueMap::IDENTITY, source)
 }
 
 #[cfg(test)]
@@ -132,5 +162,17 @@ mod tests {
         assert_eq!((v(25), v(27)), (1.0, 0.0));
         let off = s.code(26, 17, 16) as f32 / 255.0; // d = √101 − 10
         assert!((off - (0.5 - (101f32.sqrt() - 10.0) / 2.0)).abs() < 0.003, "{off}");
+    }
+
+    #[test]
+    fn lattice_bars_have_their_period_and_width() {
+        let v = lattice(96).unwrap();
+        // Period 4, width 2: a voxel is on a bar when two of its coordinates are 0 or 1
+        // modulo 4; the fraction is 3·(1/2)²·(1/2) + (1/2)³ = 1/2.
+        let on = (0..v.voxels.len()).filter(|&i| v.voxels.code(i) == 255).count();
+        assert!((on as f32 / v.voxels.len() as f32 - 0.5).abs() < 1e-6);
+        assert_eq!(v.code(1, 1, 3), 255);
+        assert_eq!(v.code(2, 3, 1), 0);
+        assert_eq!("lattice".parse::<Phantom>().unwrap(), Phantom::Lattice);
     }
 }
