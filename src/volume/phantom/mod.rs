@@ -68,6 +68,11 @@ impl FromStr for Phantom {
     }
 }
 
+/// The source record of an 8-bit test phantom.
+fn source_u8(detail: String) -> Source {
+    Source { format: "phantom".into(), path: None, sample_type: "uint8".into(), details: vec![("phantom".into(), detail)] }
+}
+
 /// A ball of radius `radius` voxels centred in an `n³` unit-spacing grid, value 1 inside
 /// and 0 outside (8-bit codes 255 and 0), with a linear edge ramp two voxels wide
 /// ([`shapes::paint`]): the normalised value 0.5 lies exactly at the radius, and
@@ -78,13 +83,7 @@ pub fn sphere(n: u32, radius: f32) -> Result<Volume, String> {
     let layers = [Layer::new(Shape::Ellipsoid { center: Vec3::ZERO, radii: Vec3::splat(radius) }, 255.0, 1)];
     let painted = paint(grid.dims, 1.0, 2.0, grid.origin, 0.0, &layers, |_, v| v);
     let codes = painted.values.iter().map(|&v| v.round() as u8).collect();
-    let source = Source {
-        format: "phantom".into(),
-        path: None,
-        sample_type: "uint8".into(),
-        details: vec![("phantom".into(), format!("sphere r = {radius} voxels"))],
-    };
-    Volume::new("sphere phantom", grid, Voxels::U8(codes), ValueMap::IDENTITY, source)
+    Volume::new("sphere phantom", grid, Voxels::U8(codes), ValueMap::IDENTITY, source_u8(format!("sphere r = {radius} voxels")))
 }
 
 /// A cubic lattice in an `n³` unit-spacing grid: bars along the three axes, one every
@@ -103,13 +102,7 @@ pub fn lattice(n: u32) -> Result<Volume, String> {
             if axes >= 2 { 255 } else { 0 }
         })
         .collect();
-    let source = Source {
-        format: "phantom".into(),
-        path: None,
-        sample_type: "uint8".into(),
-        details: vec![("phantom".into(), format!("lattice, bars every {period} voxels, {width} thick"))],
-    };
-    Volume::new("lattice phantom", grid, Voxels::U8(codes), ValueMap::IDENTITY, source)
+    Volume::new("lattice phantom", grid, Voxels::U8(codes), ValueMap::IDENTITY, source_u8(format!("lattice, bars every {period} voxels, {width} thick")))
 }
 
 #[cfg(test)]
