@@ -20,7 +20,7 @@
 #import focal::camera::{Ray, pixel_ray, scene_depth_t, jitter}
 #import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod}
 #import focal::regions::{region_interval, to_voxel, dir_to_voxel, world_step}
-#import focal::sampling::{trilinear, nearest_code, index_gradient, brick_occupied, brick_exit, brick_range}
+#import focal::sampling::{trilinear, nearest_code, index_gradient, brick_occupied, brick_exit, brick_range, at_full_resolution}
 #import focal::transfer::{classify, classify_label, correct_opacity}
 #import focal::shading::shade
 #import focal::compositing::composite
@@ -234,8 +234,12 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                         break;
                     }
                     let q = q0 + dq * (kk - k);
-                    // Bricks that cannot change the running max (min) need no samples.
-                    if skip && c > 0u && r.mode != MODE_X_RAY {
+#ifdef HAS_LENSES
+                    update_lod(t_start + (kk + j) * step);
+#endif
+                    // Bricks that cannot change the running max (min) need no samples
+                    // (their ranges hold for full-resolution samples only).
+                    if skip && c > 0u && r.mode != MODE_X_RAY && at_full_resolution() {
                         let range = brick_range(r, q);
                         if (r.mode == MODE_MIP && range.y <= mx) || (r.mode == MODE_MIN_IP && range.x >= mn) {
                             let tk = t_start + (kk + j) * step;
@@ -243,9 +247,6 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                             continue;
                         }
                     }
-#ifdef HAS_LENSES
-                    update_lod(t_start + (kk + j) * step);
-#endif
                     let v = trilinear(r, q);
                     mx = max(mx, v);
                     mn = min(mn, v);
@@ -299,14 +300,16 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                         break;
                     }
                     let q = q0 + dq * (kk - k);
-                    if occupancy && !brick_occupied(r, q) {
+#ifdef HAS_LENSES
+                    update_lod(t_start + (kk + j) * step);
+#endif
+                    // Occupancy holds for full-resolution samples only (a coarser level
+                    // blends in neighbouring bricks).
+                    if occupancy && at_full_resolution() && !brick_occupied(r, q) {
                         let tk = t_start + (kk + j) * step;
                         kk = max(kk + 1.0, ceil((brick_exit(r, q, qd, tk) - t_start) / step - j));
                         continue;
                     }
-#ifdef HAS_LENSES
-                    update_lod(t_start + (kk + j) * step);
-#endif
                     acc = dvr_sample(r, q, ratios[s], ray.dir, acc);
                     kk += 1.0;
                 }
@@ -352,7 +355,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
             }
 #endif
 #ifdef HAS_DVR
-            if !skip || (r.flags & REGION_OCCUPANCY) == 0u || brick_occupied(r, q) {
+            if !skip || (r.flags & REGION_OCCUPANCY) == 0u || !at_full_resolution() || brick_occupied(r, q) {
                 acc = dvr_sample(r, q, ratios[s], ray.dir, acc);
             }
 #endif

@@ -285,10 +285,14 @@ fn lod_at(t: f32) -> f32 {
     let depth = lensed_spread.depth0 + lensed_spread.depth_per_t * t;
     let lensed = spread_extent(lensed_spread, depth);
     let plain = spread_extent(plain_spread, depth);
-    if lensed > 0.0 && plain > 0.0 {
-        return clamp(log2(lensed / plain), 0.0, 3.0);
+    // As the reference: no spread (rays meeting at a point) is no compression.
+    if lensed <= 0.0 {
+        return 0.0;
     }
-    return 3.0;
+    if plain <= 0.0 {
+        return 3.0;
+    }
+    return clamp(log2(lensed / plain), 0.0, 3.0);
 }
 
 // Restricts the footprint to the ray's interval [t0, t1]: the lensed extent is convex in

@@ -16,6 +16,12 @@ fn set_lod(lod: f32) {
     sample_lod = lod;
 }
 
+// Whether samples come from the volume itself (brick ranges and occupancy hold only
+// then).
+fn at_full_resolution() -> bool {
+    return sample_lod <= 0.0;
+}
+
 // Trilinear sample of the atlas box at offset with dims, clamped to its edge voxels.
 fn trilinear_box(offset: vec3<f32>, dims: vec3<f32>, q: vec3<f32>) -> f32 {
     let c = clamp(q, vec3(0.0), dims - 1.0);

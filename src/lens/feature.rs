@@ -150,10 +150,24 @@ impl FeatureField {
         let to_in = distance_transform(mask, c, r);
         let outside: Vec<bool> = mask.iter().map(|m| !m).collect();
         let to_out = distance_transform(&outside, c, r);
+        // A feature covering the whole grid has no outside: its cells lie at least their
+        // distance to the grid's edge inside it.
+        let to_edge = |i: usize| {
+            let (x, y) = (i % c, i / c);
+            (x.min(c - 1 - x).min(y).min(r - 1 - y) + 1) as f32
+        };
         let distance = mask
             .iter()
             .enumerate()
-            .map(|(i, &m)| if m { -(to_out[i] - 0.5) * cell } else { (to_in[i] - 0.5) * cell })
+            .map(|(i, &m)| {
+                if !m {
+                    (to_in[i] - 0.5) * cell
+                } else if to_out[i].is_finite() {
+                    -(to_out[i] - 0.5) * cell
+                } else {
+                    -(to_edge(i) - 0.5) * cell
+                }
+            })
             .collect();
         let mut sum = Vec2::ZERO;
         for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
@@ -303,6 +317,10 @@ mod tests {
             assert!((d - want).abs() < 1.5 * cell, "{s}: {d} vs {want}");
         }
         assert!(FeatureField::from_mask(&vec![false; mask.len()], cols, rows, screen).is_none());
+        // A feature filling the view stays a finite field (a zoom into the feature).
+        let full = FeatureField::from_mask(&vec![true; mask.len()], cols, rows, screen).unwrap();
+        assert!(full.distance.iter().all(|d| d.is_finite() && *d < 0.0));
+        assert!(full.distance_at(Vec2::ZERO).is_finite() && full.distance_at(Vec2::new(3.0, 0.0)).is_finite());
     }
 
     #[test]

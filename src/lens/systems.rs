@@ -54,8 +54,10 @@ pub fn resolve_view_lenses(
     ordered.truncate(MAX_LENSES);
     let current: Vec<Lens> = ordered.iter().map(|(_, l, _)| (*l).clone()).collect();
     let lenses_changed = *last != current;
+    let mut all_resolved = true;
     for (camera, transform, projection, mut view) in &mut views {
         let (Some(cam), Some(size)) = (focal_camera(transform, projection), camera.physical_viewport_size()) else {
+            all_resolved = false;
             continue;
         };
         let screen = Screen::new(size.x, size.y);
@@ -68,7 +70,10 @@ pub fn resolve_view_lenses(
             *view = next;
         }
     }
-    *last = current;
+    // A view skipped this frame must see the change later.
+    if all_resolved {
+        *last = current;
+    }
 }
 
 /// Replaces every lens entity of `world` with `lenses`, in stack order.

@@ -154,7 +154,8 @@ pub fn trace_antialiased(
                     st.count += 1;
                 }
                 Mode::Dvr | Mode::GradientDvr => {
-                    if !r.occupied(q) {
+                    // Occupancy holds for full-resolution samples only.
+                    if level <= 0.0 && !r.occupied(q) {
                         continue;
                     }
                     let v = r.sample(q, level);

@@ -82,6 +82,9 @@ pub fn upload_scene(
     for d in &packed.dropped {
         warn!("{d}");
     }
+    if !packed.mips && !packed.volumes.is_empty() {
+        warn!("no room for the volumes' mip chains in one texture atlas: lenses sample full resolution where they compress (the CPU reference does not)");
+    }
     let key: Vec<usize> = packed.volumes.iter().map(|&v| Arc::as_ptr(&scene.volumes[v]) as usize).collect();
     if gpu.atlas_key != key || gpu.atlases.is_none() {
         let volumes: Vec<&Volume> = packed.volumes.iter().map(|&v| scene.volumes[v].as_ref()).collect();

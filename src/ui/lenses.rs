@@ -39,8 +39,9 @@ pub struct LensUi {
     pub show_outlines: bool,
     pub show_lattice: bool,
     pub show_readout: bool,
-    /// The lattice last computed, for the view lenses it was computed for.
-    lattice: Option<(ViewLenses, Vec<[Vec2; 2]>)>,
+    /// The lattice last computed, with the view lenses and scene bounds it was
+    /// computed for.
+    lattice: Option<((ViewLenses, (Vec3, f32)), Vec<[Vec2; 2]>)>,
 }
 
 impl Default for LensUi {
@@ -256,7 +257,7 @@ fn lens_settings(ui: &mut egui::Ui, lens: &mut Lens) {
     egui::ComboBox::from_label("kind").selected_text(lens.kind_name()).show_ui(ui, |ui| {
         for (name, kind) in kinds {
             if ui.selectable_label(lens.kind_name() == name, name).clicked() && lens.kind_name() != name {
-                if !matches!(kind, LensKind::Magnifier { .. }) && matches!(lens.shape, Shape::Polygon(_)) {
+                if !matches!(kind, LensKind::Magnifier { .. }) && matches!(lens.shape, Shape::Polygon(_) | Shape::Feature(_)) {
                     lens.shape = Shape::Circle;
                 }
                 if matches!(kind, LensKind::Angular { .. }) {
@@ -401,16 +402,17 @@ pub fn overlay(ctx: &egui::Context, free: Rect, params: &mut LensParams, regions
         && let Some(view) = &view
         && let (Some(cam), Some(vs)) = (view.camera, view.screen)
     {
-        let fresh = params.ui.lattice.as_ref().is_none_or(|(v, _)| v != view);
+        let bounds = regions.scene.bounding_sphere();
+        let fresh = params.ui.lattice.as_ref().is_none_or(|((v, b), _)| v != view || *b != bounds);
         if fresh {
-            let (centre, radius) = regions.scene.bounding_sphere();
+            let (centre, radius) = bounds;
             let depth = (centre - cam.position).dot(cam.forward()).max(radius * 0.05);
             let view_height = match cam.projection {
                 crate::region::Projection::Perspective { fov_y } => 2.0 * depth * (fov_y * 0.5).tan(),
                 crate::region::Projection::Orthographic { height } => height,
             };
             let segments = lattice(&cam, vs, &view.lenses, depth, round_spacing(view_height, 16.0), 6.0);
-            params.ui.lattice = Some((view.clone(), segments));
+            params.ui.lattice = Some(((view.clone(), bounds), segments));
         }
         if let Some((_, segments)) = &params.ui.lattice {
             let k = free.height() / vs.height;

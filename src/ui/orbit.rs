@@ -177,7 +177,15 @@ pub fn wheel_lines(scroll: &AccumulatedMouseScroll) -> f32 {
 
 /// Fly-through keys: arrows move forward, back and sideways, Page Up / Down up and down,
 /// Shift four times faster.
-pub fn fly_keys(keys: Res<ButtonInput<KeyCode>>, time: Res<Time<Real>>, mut cams: Query<&mut OrbitCamera>) {
+pub fn fly_keys(
+    keys: Res<ButtonInput<KeyCode>>,
+    time: Res<Time<Real>>,
+    mut contexts: bevy_egui::EguiContexts,
+    mut cams: Query<&mut OrbitCamera>,
+) {
+    if contexts.ctx_mut().is_ok_and(|c| c.egui_wants_keyboard_input()) {
+        return;
+    }
     let Ok(mut orbit) = cams.single_mut() else { return };
     if !orbit.fly {
         return;
