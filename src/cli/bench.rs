@@ -177,10 +177,19 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let a = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone")?);
         let (plain, _) = bench.show(ct.clone(), a.clone(), still)?;
         let base = "no lens".to_string();
-        rows.push(Row { group: "lenses", config: base.clone(), ms: plain, baseline: base.clone(), ratio: 1.0, note: "head phantom, CT skin + bone".into() });
+        rows.push(Row {
+            group: "lenses",
+            config: base.clone(),
+            ms: plain,
+            baseline: base.clone(),
+            ratio: 1.0,
+            note: "head phantom, CT skin + bone".into(),
+        });
         let magnifier = Lens::magnifier(Vec2::new(0.1, 0.05), 0.3, 0.15, 2.5);
-        let sampling = Lens { kind: LensKind::Sampling(Sampling::Cubic { center_rate: 3.0 }), ..Lens::magnifier(Vec2::ZERO, 0.5, 0.0, 1.0) };
-        let fisheye = Lens { kind: LensKind::Angular { field_of_view: 120.0, whole_view: false }, ..Lens::magnifier(Vec2::ZERO, 0.5, 0.0, 1.0) };
+        let sampling =
+            Lens { kind: LensKind::Sampling(Sampling::Cubic { center_rate: 3.0 }), ..Lens::magnifier(Vec2::ZERO, 0.5, 0.0, 1.0) };
+        let fisheye =
+            Lens { kind: LensKind::Angular { field_of_view: 120.0, whole_view: false }, ..Lens::magnifier(Vec2::ZERO, 0.5, 0.0, 1.0) };
         let four = vec![
             Lens::magnifier(Vec2::new(-0.5, 0.4), 0.25, 0.1, 2.0),
             Lens::magnifier(Vec2::new(0.5, 0.4), 0.25, 0.1, 3.0),
@@ -197,7 +206,14 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         for (name, lenses, antialias) in configs {
             replace_lenses(bench.off.world_mut(), &lenses);
             let (ms, _) = bench.show(ct.clone(), a.clone(), VolumeView { lens_antialias: antialias, ..still })?;
-            rows.push(Row { group: "lenses", config: name.into(), ms, baseline: base.clone(), ratio: ms / plain.max(1e-9), note: "goal ≤ ×1.10".into() });
+            rows.push(Row {
+                group: "lenses",
+                config: name.into(),
+                ms,
+                baseline: base.clone(),
+                ratio: ms / plain.max(1e-9),
+                note: "goal ≤ ×1.10".into(),
+            });
         }
         replace_lenses(bench.off.world_mut(), &[]);
     }

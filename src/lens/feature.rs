@@ -311,7 +311,9 @@ mod tests {
         assert!((f.centroid - centre).length() < 0.01, "{}", f.centroid);
         assert!((f.equivalent_radius() - 0.4).abs() < 0.01, "{}", f.equivalent_radius());
         // Distances to the silhouette, inside and out, within a cell.
-        for (s, want) in [(centre, -0.4), (centre + Vec2::new(0.6, 0.0), 0.2), (centre + Vec2::new(0.0, 0.3), -0.1), (Vec2::new(-0.9, 0.9), 0.0)] {
+        for (s, want) in
+            [(centre, -0.4), (centre + Vec2::new(0.6, 0.0), 0.2), (centre + Vec2::new(0.0, 0.3), -0.1), (Vec2::new(-0.9, 0.9), 0.0)]
+        {
             let want = if want == 0.0 { (Vec2::new(-0.9, 0.9) - centre).length() - 0.4 } else { want };
             let d = f.distance_at(s);
             assert!((d - want).abs() < 1.5 * cell, "{s}: {d} vs {want}");
@@ -328,7 +330,9 @@ mod tests {
         use crate::lens::stack::{lens_ray, resolve_in};
         use crate::lens::{Lens, Shape};
         use crate::scene::load::{camera, load_datasets, render_scene, visible_bounds};
-        let file = crate::scene::SceneFile::parse("(datasets: [(source: PhantomLabels(resolution: 48), appearance: (labels: Some(())))])", "t").unwrap();
+        let file =
+            crate::scene::SceneFile::parse("(datasets: [(source: PhantomLabels(resolution: 48), appearance: (labels: Some(())))])", "t")
+                .unwrap();
         let datasets = load_datasets(&file, std::path::Path::new(".")).unwrap();
         let scene = render_scene(&datasets, &file);
         let cam = camera(&file.camera, visible_bounds(&datasets), 1.0);

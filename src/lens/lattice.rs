@@ -20,7 +20,14 @@ const MAX_LINES_PER_CELL: i32 = 4;
 
 /// Lattice coordinates `(u, v)` at every sample, `step` pixels apart (`NaN` where a pixel
 /// has no ray or its ray misses the plane).
-fn sample_fields(camera: &Camera, screen: Screen, lenses: &[ResolvedLens], depth: f32, spacing: f32, step: f32) -> (usize, usize, Vec<Vec2>) {
+fn sample_fields(
+    camera: &Camera,
+    screen: Screen,
+    lenses: &[ResolvedLens],
+    depth: f32,
+    spacing: f32,
+    step: f32,
+) -> (usize, usize, Vec<Vec2>) {
     let nx = (screen.width / step).ceil() as usize + 1;
     let ny = (screen.height / step).ceil() as usize + 1;
     let (fwd, right, up) = (camera.forward(), camera.right(), camera.up());

@@ -23,9 +23,9 @@ use glam::{Vec3, Vec4};
 
 use super::prepare::PreparedRegion;
 use crate::lens::antialias::Footprint;
-use crate::volume::pyramid::MIP_LEVELS;
 use crate::region::{Light, Mode, Ray, Shading};
 use crate::transfer::opacity;
+use crate::volume::pyramid::MIP_LEVELS;
 
 /// Accumulated opacity at which a ray stops.
 pub const EARLY_TERMINATION: f32 = 0.99;

@@ -280,7 +280,10 @@ mod tests {
         assert_eq!(packed.atlas.size, UVec3::new(16, 16, 30));
         assert!(packed.mips);
         assert_eq!(packed.regions[1].mip_count, 3);
-        assert_eq!(packed.regions[1].mips, [glam::Vec4::new(0.0, 0.0, 16.0, 1.0), glam::Vec4::new(0.0, 0.0, 24.0, 1.0), glam::Vec4::new(0.0, 0.0, 28.0, 1.0)]);
+        assert_eq!(
+            packed.regions[1].mips,
+            [glam::Vec4::new(0.0, 0.0, 16.0, 1.0), glam::Vec4::new(0.0, 0.0, 24.0, 1.0), glam::Vec4::new(0.0, 0.0, 28.0, 1.0)]
+        );
         assert_eq!((packed.regions[0].plane_offset, packed.regions[0].plane_count), (0, 6));
         assert_eq!((packed.regions[1].plane_offset, packed.regions[1].plane_count), (6, 7));
         assert_eq!(packed.regions[0].mode, mode::MIP);

@@ -83,7 +83,9 @@ pub fn upload_scene(
         warn!("{d}");
     }
     if !packed.mips && !packed.volumes.is_empty() {
-        warn!("no room for the volumes' mip chains in one texture atlas: lenses sample full resolution where they compress (the CPU reference does not)");
+        warn!(
+            "no room for the volumes' mip chains in one texture atlas: lenses sample full resolution where they compress (the CPU reference does not)"
+        );
     }
     let key: Vec<usize> = packed.volumes.iter().map(|&v| Arc::as_ptr(&scene.volumes[v]) as usize).collect();
     if gpu.atlas_key != key || gpu.atlases.is_none() {

@@ -195,7 +195,11 @@ pub fn panel(ui: &mut egui::Ui, params: &mut LensParams) {
             params.add(Lens { kind, ..Lens::magnifier(Vec2::ZERO, 0.4, 0.0, 1.0) });
         }
         let drawing = params.ui.drawing.is_some();
-        if ui.add_enabled(room || drawing, egui::Button::new("✏ draw").selected(drawing)).on_hover_text("drag an outline in the view").clicked() {
+        if ui
+            .add_enabled(room || drawing, egui::Button::new("✏ draw").selected(drawing))
+            .on_hover_text("drag an outline in the view")
+            .clicked()
+        {
             params.ui.drawing = if drawing { None } else { Some(Vec::new()) };
         }
     });

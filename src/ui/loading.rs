@@ -78,29 +78,28 @@ pub fn start_loads(mut commands: Commands, mut requests: MessageReader<LoadReque
     for request in requests.read() {
         let progress = Progress::default();
         let p = progress.clone();
-        let (what, job): (String, Box<dyn FnOnce() -> Result<Loaded, String> + Send>) =
-            match request.clone() {
-                LoadRequest::Path(path) => (
-                    path.display().to_string(),
-                    Box::new(move || {
-                        let is_scene = path.extension().is_some_and(|e| e == "ron");
-                        let (scene, base) = if is_scene {
-                            (read_scene(&path)?, path.parent().map(Path::to_path_buf).unwrap_or_default())
-                        } else {
-                            (scene_for_file(&path), PathBuf::new())
-                        };
-                        let datasets = load_datasets_with(&scene, &base, Some(p))?;
-                        Ok((scene, base, datasets, is_scene))
-                    }),
-                ),
-                LoadRequest::Scene(scene, base) => (
-                    "scene".to_string(),
-                    Box::new(move || {
-                        let datasets = load_datasets_with(&scene, &base, Some(p))?;
-                        Ok((scene, base, datasets, true))
-                    }),
-                ),
-            };
+        let (what, job): (String, Box<dyn FnOnce() -> Result<Loaded, String> + Send>) = match request.clone() {
+            LoadRequest::Path(path) => (
+                path.display().to_string(),
+                Box::new(move || {
+                    let is_scene = path.extension().is_some_and(|e| e == "ron");
+                    let (scene, base) = if is_scene {
+                        (read_scene(&path)?, path.parent().map(Path::to_path_buf).unwrap_or_default())
+                    } else {
+                        (scene_for_file(&path), PathBuf::new())
+                    };
+                    let datasets = load_datasets_with(&scene, &base, Some(p))?;
+                    Ok((scene, base, datasets, is_scene))
+                }),
+            ),
+            LoadRequest::Scene(scene, base) => (
+                "scene".to_string(),
+                Box::new(move || {
+                    let datasets = load_datasets_with(&scene, &base, Some(p))?;
+                    Ok((scene, base, datasets, true))
+                }),
+            ),
+        };
         let task = AsyncComputeTaskPool::get().spawn(async move { job() });
         commands.spawn(Loading { what, progress, task });
     }

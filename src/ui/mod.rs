@@ -127,7 +127,19 @@ impl Plugin for FocalAppPlugin {
             )
             .add_systems(
                 Update,
-                (lenses::lens_input, lenses::lens_keys, orbit::orbit_input, orbit::fly_keys, shortcuts, dropped_files, centre_on_double_click, reframe, sync_view, automation, orbit::apply_orbit)
+                (
+                    lenses::lens_input,
+                    lenses::lens_keys,
+                    orbit::orbit_input,
+                    orbit::fly_keys,
+                    shortcuts,
+                    dropped_files,
+                    centre_on_double_click,
+                    reframe,
+                    sync_view,
+                    automation,
+                    orbit::apply_orbit,
+                )
                     .chain(),
             )
             .add_systems(EguiPrimaryContextPass, panels::ui);

@@ -32,7 +32,16 @@ pub struct OrbitCamera {
 
 impl Default for OrbitCamera {
     fn default() -> Self {
-        Self { target: Vec3::ZERO, azimuth_deg: 35.0, elevation_deg: 20.0, distance: 600.0, orthographic: false, fov_deg: 30.0, fly: false, fly_speed: 100.0 }
+        Self {
+            target: Vec3::ZERO,
+            azimuth_deg: 35.0,
+            elevation_deg: 20.0,
+            distance: 600.0,
+            orthographic: false,
+            fov_deg: 30.0,
+            fly: false,
+            fly_speed: 100.0,
+        }
     }
 }
 
@@ -191,8 +200,11 @@ pub fn fly_keys(
         return;
     }
     let axis = |plus: KeyCode, minus: KeyCode| keys.pressed(plus) as i32 as f32 - keys.pressed(minus) as i32 as f32;
-    let (right, up, forward) =
-        (axis(KeyCode::ArrowRight, KeyCode::ArrowLeft), axis(KeyCode::PageUp, KeyCode::PageDown), axis(KeyCode::ArrowUp, KeyCode::ArrowDown));
+    let (right, up, forward) = (
+        axis(KeyCode::ArrowRight, KeyCode::ArrowLeft),
+        axis(KeyCode::PageUp, KeyCode::PageDown),
+        axis(KeyCode::ArrowUp, KeyCode::ArrowDown),
+    );
     if right == 0.0 && up == 0.0 && forward == 0.0 {
         return;
     }

@@ -91,7 +91,17 @@ impl Volume {
             return Err(format!("value rescale {}·v + {} is not usable", values.slope, values.intercept));
         }
         let stats = stats::compute(&voxels, &values);
-        Ok(Volume { name: name.into(), grid, voxels, values, stats, source, bricks: OnceLock::new(), gradient_max: OnceLock::new(), pyramid: OnceLock::new() })
+        Ok(Volume {
+            name: name.into(),
+            grid,
+            voxels,
+            values,
+            stats,
+            source,
+            bricks: OnceLock::new(),
+            gradient_max: OnceLock::new(),
+            pyramid: OnceLock::new(),
+        })
     }
 
     pub fn dims(&self) -> UVec3 {

@@ -196,7 +196,9 @@ fn fine_pattern() -> (Arc<Volume>, Appearance, FocalCamera) {
             (127.5 + 63.0 * (w(x) + w(y))).round() as u8
         })
         .collect();
-    let v = Arc::new(Volume::new("pattern", Grid::centered(dims, Vec3::ONE), Voxels::U8(codes), ValueMap::IDENTITY, Source::default()).unwrap());
+    let v = Arc::new(
+        Volume::new("pattern", Grid::centered(dims, Vec3::ONE), Voxels::U8(codes), ValueMap::IDENTITY, Source::default()).unwrap(),
+    );
     let mut a = Appearance::new(Mode::XRay, opaque_ramp());
     a.shading.enabled = false;
     let cam = FocalCamera {

@@ -102,7 +102,13 @@ pub fn lattice(n: u32) -> Result<Volume, String> {
             if axes >= 2 { 255 } else { 0 }
         })
         .collect();
-    Volume::new("lattice phantom", grid, Voxels::U8(codes), ValueMap::IDENTITY, source_u8(format!("lattice, bars every {period} voxels, {width} thick")))
+    Volume::new(
+        "lattice phantom",
+        grid,
+        Voxels::U8(codes),
+        ValueMap::IDENTITY,
+        source_u8(format!("lattice, bars every {period} voxels, {width} thick")),
+    )
 }
 
 #[cfg(test)]
