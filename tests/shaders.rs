@@ -48,8 +48,13 @@ fn every_shader_variant_composes_and_validates() {
             .filter(|(i, _)| bits & (1 << i) != 0)
             .map(|(_, d)| (d.to_string(), ShaderDefValue::Bool(true)))
             .collect();
-        compose_and_validate(defs);
+        compose_and_validate("shaders/raycast.wgsl", defs);
     }
+}
+
+#[test]
+fn the_feature_lens_compute_shader_composes_and_validates() {
+    compose_and_validate("shaders/feature.wgsl", HashMap::new());
 }
 
 #[test]
@@ -58,8 +63,8 @@ fn def_names_match_the_renderer() {
     assert_eq!(names, DEFS);
 }
 
-fn compose_and_validate(shader_defs: HashMap<String, ShaderDefValue>) {
-    let label = format!("{:?}", shader_defs.keys().collect::<Vec<_>>());
+fn compose_and_validate(entry: &str, shader_defs: HashMap<String, ShaderDefValue>) {
+    let label = format!("{entry} {:?}", shader_defs.keys().collect::<Vec<_>>());
     let mut composer = Composer::default();
     add(&mut composer, BEVY_VIEW, "bevy_view.wgsl");
     add(&mut composer, BEVY_FULLSCREEN, "fullscreen.wgsl");
@@ -69,13 +74,13 @@ fn compose_and_validate(shader_defs: HashMap<String, ShaderDefValue>) {
     for (path, source) in &sources {
         add(&mut composer, source, path);
     }
-    let main = read("shaders/raycast.wgsl");
+    let main = read(entry);
     let module = composer
         .make_naga_module(NagaModuleDescriptor {
             source: &main,
-            file_path: "shaders/raycast.wgsl",
+            file_path: entry,
             shader_type: ShaderType::Wgsl,
-            shader_defs: HashMap::new(),
+            shader_defs,
             additional_imports: &[],
         })
         .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));

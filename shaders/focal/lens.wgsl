@@ -18,6 +18,8 @@ const SHAPE_FEATURE: u32 = 3u;
 const PROFILE_SIMPLE: u32 = 0u;
 const PROFILE_LINEAR: u32 = 1u;
 const SAMPLING_TABLE: u32 = 64u;
+// Floats before a silhouette's distances: centroid, equivalent radius, in view (feature.rs).
+const FIELD_HEADER: u32 = 4u;
 
 fn view_aspect() -> f32 {
     return view.viewport.z / view.viewport.w;
@@ -93,7 +95,7 @@ fn feature_distance(base: u32, s: vec2<f32>) -> f32 {
     let y1 = min(y0 + 1u, rows - 1u);
     let fx = x - f32(x0);
     let fy = y - f32(y0);
-    let o = u32(h.z);
+    let o = u32(h.z) + FIELD_HEADER;
     let top = mix(feature_fields[o + y0 * cols + x0], feature_fields[o + y0 * cols + x1], fx);
     let bottom = mix(feature_fields[o + y1 * cols + x0], feature_fields[o + y1 * cols + x1], fx);
     return mix(top, bottom, fy) + beyond;
@@ -194,8 +196,17 @@ fn lens_ray(uv: vec2<f32>) -> Ray {
     let s = to_lens(uv);
     var ray = camera_ray(uv);
     for (var i = 0u; i < settings.lens_count; i++) {
-        let lens = settings.lenses[i];
+        var lens = settings.lenses[i];
         let base = i * LENS_DATA;
+        // A feature lens is centred on its silhouette and sized by it; a feature out of
+        // view leaves the rays alone.
+        if lens.codes.y == SHAPE_FEATURE {
+            let o = u32(settings.lens_data[base + 1u].z);
+            if feature_fields[o + 3u] < 0.5 {
+                continue;
+            }
+            lens.geometry = vec4(feature_fields[o], feature_fields[o + 1u], feature_fields[o + 2u], lens.geometry.w);
+        }
         let centre = lens.geometry.xy;
         let lr = lens.geometry.z;
         let v = s - centre;
@@ -234,7 +245,7 @@ struct Spread {
     qx: vec3<f32>,
     py: vec3<f32>,
     qy: vec3<f32>,
-    depth0: f32,
+    depth_start: f32,
     depth_per_t: f32,
 }
 
@@ -282,7 +293,7 @@ fn lens_footprint(uv: vec2<f32>, ray: Ray) {
 
 // Mip level at ray parameter t.
 fn lod_at(t: f32) -> f32 {
-    let depth = lensed_spread.depth0 + lensed_spread.depth_per_t * t;
+    let depth = lensed_spread.depth_start + lensed_spread.depth_per_t * t;
     let lensed = spread_extent(lensed_spread, depth);
     let plain = spread_extent(plain_spread, depth);
     // As the reference: no spread (rays meeting at a point) is no compression.

@@ -68,6 +68,18 @@ struct Bench {
 
 impl Bench {
     fn show(&mut self, volume: Arc<Volume>, appearance: Appearance, view: VolumeView) -> Result<(f64, image::RgbaImage), String> {
+        self.show_with(volume, appearance, view, false)
+    }
+
+    /// [`Self::show`]; with `orbit`, the camera turns half a degree about the volume
+    /// every timed frame (so what depends on the camera is recomputed each frame).
+    fn show_with(
+        &mut self,
+        volume: Arc<Volume>,
+        appearance: Appearance,
+        view: VolumeView,
+        orbit: bool,
+    ) -> Result<(f64, image::RgbaImage), String> {
         let world = self.off.world_mut();
         let old: Vec<Entity> = world.query_filtered::<Entity, With<Dataset>>().iter(world).collect();
         for e in old {
@@ -75,10 +87,21 @@ impl Bench {
         }
         let (lo, hi) = appearance.visible_bounds(&volume).unwrap_or_else(|| volume.grid.world_bounds());
         self.off.world_mut().spawn((Dataset::new(volume, appearance), Transform::default()));
-        self.off.set_camera(&View::Oblique.frame_box(lo, hi, self.off.width as f32 / self.off.height as f32, false));
+        let camera = View::Oblique.frame_box(lo, hi, self.off.width as f32 / self.off.height as f32, false);
+        self.off.set_camera(&camera);
         self.off.set_view(view);
         let image = self.off.capture()?;
-        let t = self.off.time_frames(self.frames);
+        let centre = (lo + hi) * 0.5;
+        let t = self.off.time_frames_with(self.frames, |off, k| {
+            if orbit {
+                let turn = Quat::from_rotation_y((k + 1) as f32 * 0.5f32.to_radians());
+                off.set_camera(&focal::region::Camera {
+                    position: centre + turn * (camera.position - centre),
+                    rotation: turn * camera.rotation,
+                    ..camera
+                });
+            }
+        });
         Ok((t.as_secs_f64() * 1000.0, image))
     }
 }
@@ -213,6 +236,44 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
                 baseline: base.clone(),
                 ratio: ms / plain.max(1e-9),
                 note: "goal ≤ ×1.10".into(),
+            });
+        }
+        replace_lenses(bench.off.world_mut(), &[]);
+
+        // The feature lens needs its silhouette again whenever the camera moves: timed
+        // while orbiting, silhouettes on the GPU (compute passes) and on the CPU.
+        let head = phantom::head::generate(args.resolution)?;
+        let labels = Appearance {
+            lookup: Lookup::Labels(LabelTransfer::from_table(
+                &head.labels.table,
+                head.labels.present_ids().into_iter().map(|(id, _)| id),
+                0.4,
+            )),
+            ..Appearance::new(Mode::Dvr, presets::builtin("grayscale_ramp")?)
+        };
+        let volume = Arc::new(head.labels.volume.clone());
+        let (orbit, _) = bench.show_with(volume.clone(), labels.clone(), still, true)?;
+        let base = "no lens, orbiting".to_string();
+        rows.push(Row {
+            group: "lenses",
+            config: base.clone(),
+            ms: orbit,
+            baseline: base.clone(),
+            ratio: 1.0,
+            note: "head phantom labels".into(),
+        });
+        let ventricles = focal::lens::feature::FeatureRef { label: phantom::head::label::VENTRICLES as u32, region: None };
+        let feature = Lens { shape: focal::lens::Shape::Feature(ventricles), ..Lens::magnifier(Vec2::ZERO, 0.3, 0.15, 2.5) };
+        replace_lenses(bench.off.world_mut(), &[feature]);
+        for (name, gpu) in [("feature (GPU)", true), ("feature (CPU)", false)] {
+            let (ms, _) = bench.show_with(volume.clone(), labels.clone(), VolumeView { gpu_silhouettes: gpu, ..still }, true)?;
+            rows.push(Row {
+                group: "lenses",
+                config: name.into(),
+                ms,
+                baseline: base.clone(),
+                ratio: ms / orbit.max(1e-9),
+                note: "silhouette every frame".into(),
             });
         }
         replace_lenses(bench.off.world_mut(), &[]);

@@ -16,6 +16,15 @@
 //! 3. The lens centre is the silhouette's centroid (the central ray and `F` go through
 //!    it) and its radius the equivalent radius `lr = √(area/π)`; the radial coordinate is
 //!    `r = lr + d(s)`, as for a drawn outline ([`super::shape`]).
+//!
+//! The GPU does all three each frame in compute passes (`shaders/feature.wgsl`): the
+//! same mask, then jump flooding (Rong and Tan 2006, with one extra pass of step 1)
+//! for the nearest inside and outside cells, atomic sums for the centroid and area.
+//! The lens systems then only describe the work ([`FeatureJob`]); the functions here
+//! are the CPU reference (and serve the CPU renderer and the app's overlays). Jump
+//! flooding is not exact: a few cells may take a seed slightly farther than the nearest.
+//! Because the centre is only known after the mask, a feature lens takes its focus
+//! depth on the view axis (through the image centre), not through its centroid.
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -38,6 +47,65 @@ pub struct FeatureRef {
     /// default the first region shown with labels.
     #[serde(default)]
     pub region: Option<usize>,
+}
+
+/// Floats before a silhouette's distances in the shader's buffer: centroid (2), the
+/// equivalent radius, and 1 when the feature is in view (0 when not).
+pub const FIELD_HEADER: usize = 4;
+
+/// The grid of a feature's silhouette over one screen: [`FIELD_ROWS`] rows of square
+/// cells (in lens units) covering the image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FeatureGrid {
+    pub cols: u32,
+    pub rows: u32,
+    /// Lens coordinates of the centre of cell (0, 0) (top left).
+    pub origin: Vec2,
+    /// Cell size (lens units; horizontal and vertical, equal up to rounding).
+    pub step: Vec2,
+}
+
+impl FeatureGrid {
+    pub fn of(screen: Screen) -> FeatureGrid {
+        let (cols, rows) = ((FIELD_ROWS as f32 * screen.aspect()).round().max(1.0) as u32, FIELD_ROWS);
+        let step = Vec2::new(2.0 * screen.aspect() / cols as f32, 2.0 / rows as f32);
+        FeatureGrid { cols, rows, origin: Vec2::new(-screen.aspect() + 0.5 * step.x, 1.0 - 0.5 * step.y), step }
+    }
+
+    pub fn cells(&self) -> usize {
+        (self.cols * self.rows) as usize
+    }
+
+    /// Lens coordinates of the centre of cell `i` (row major, top row first).
+    pub fn centre(&self, i: usize) -> Vec2 {
+        let c = self.cols as usize;
+        self.origin + Vec2::new((i % c) as f32 * self.step.x, -((i / c) as f32) * self.step.y)
+    }
+}
+
+/// What the GPU needs to find a feature's silhouette: the region holding the label
+/// volume (index among the scene's regions), the label, the marching step (world units,
+/// half the finest voxel spacing) and the grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FeatureJob {
+    pub region: u32,
+    pub label: u32,
+    pub step: f32,
+    pub grid: FeatureGrid,
+}
+
+impl FeatureJob {
+    /// The job of `feature` in `scene` over `screen`; `None` when no region shows it.
+    pub fn new(scene: &RenderScene, feature: &FeatureRef, screen: Screen) -> Option<FeatureJob> {
+        let region = feature_region(scene, feature)?;
+        let volume = scene.volumes.get(scene.regions[region].volume)?;
+        Some(FeatureJob {
+            region: region as u32,
+            label: feature.label,
+            step: 0.5 * volume.grid.min_spacing(),
+            grid: FeatureGrid::of(screen),
+        })
+    }
 }
 
 /// A feature's silhouette in one view: its signed distance field on the grid.
@@ -137,16 +205,15 @@ pub fn distance_transform(seed: &[bool], cols: usize, rows: usize) -> Vec<f32> {
 impl FeatureField {
     /// The field of a mask over a screen (`cols × rows` cells covering the image); `None`
     /// when the mask is empty.
-    pub fn from_mask(mask: &[bool], cols: u32, rows: u32, screen: Screen) -> Option<FeatureField> {
+    pub fn from_mask(mask: &[bool], grid: FeatureGrid, screen: Screen) -> Option<FeatureField> {
+        let (cols, rows) = (grid.cols, grid.rows);
         let (c, r) = (cols as usize, rows as usize);
         let inside = mask.iter().filter(|&&m| m).count();
         if inside == 0 {
             return None;
         }
-        // Cells are square in lens units when cols = rows·aspect ([`grid_size`]).
-        let step = Vec2::new(2.0 * screen.aspect() / cols as f32, 2.0 / rows as f32);
+        let (step, origin) = (grid.step, grid.origin);
         let cell = step.y;
-        let origin = Vec2::new(-screen.aspect() + 0.5 * step.x, 1.0 - 0.5 * step.y);
         let to_in = distance_transform(mask, c, r);
         let outside: Vec<bool> = mask.iter().map(|m| !m).collect();
         let to_out = distance_transform(&outside, c, r);
@@ -171,7 +238,7 @@ impl FeatureField {
             .collect();
         let mut sum = Vec2::ZERO;
         for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
-            sum += origin + Vec2::new((i % c) as f32 * step.x, -((i / c) as f32) * step.y);
+            sum += grid.centre(i);
         }
         Some(FeatureField {
             cols,
@@ -183,6 +250,11 @@ impl FeatureField {
             centroid: sum / inside as f32,
             area: inside as f32 * step.x * step.y,
         })
+    }
+
+    /// The header the shader reads before the distances ([`FIELD_HEADER`]).
+    pub fn header(&self) -> [f32; FIELD_HEADER] {
+        [self.centroid.x, self.centroid.y, self.equivalent_radius(), 1.0]
     }
 
     /// Equivalent radius `√(area/π)`.
@@ -214,11 +286,6 @@ impl FeatureField {
     }
 }
 
-/// Grid size for a screen: [`FIELD_ROWS`] rows and square cells.
-pub fn grid_size(screen: Screen) -> (u32, u32) {
-    ((FIELD_ROWS as f32 * screen.aspect()).round().max(1.0) as u32, FIELD_ROWS)
-}
-
 /// The region showing a feature: the one named, or the first shown with labels.
 fn feature_region(scene: &RenderScene, feature: &FeatureRef) -> Option<usize> {
     let labels = |i: &usize| {
@@ -230,16 +297,13 @@ fn feature_region(scene: &RenderScene, feature: &FeatureRef) -> Option<usize> {
     }
 }
 
-/// The feature mask of `feature` seen by `camera` on a `cols × rows` grid over `screen`.
-pub fn feature_mask(scene: &RenderScene, feature: &FeatureRef, camera: &Camera, screen: Screen, cols: u32, rows: u32) -> Vec<bool> {
-    let Some(region) = feature_region(scene, feature).map(|i| &scene.regions[i]) else {
-        return vec![false; (cols * rows) as usize];
-    };
-    let Some(volume) = scene.volumes.get(region.volume) else { return vec![false; (cols * rows) as usize] };
+/// The feature mask of a job seen by `camera` over `screen`.
+pub fn feature_mask(scene: &RenderScene, job: &FeatureJob, camera: &Camera, screen: Screen) -> Vec<bool> {
+    let (cols, rows) = (job.grid.cols, job.grid.rows);
+    let Some(region) = scene.regions.get(job.region as usize) else { return vec![false; job.grid.cells()] };
+    let Some(volume) = scene.volumes.get(region.volume) else { return vec![false; job.grid.cells()] };
     let sampler = VolumeSampler::of(volume);
-    let label = feature.label;
-    // Half a voxel in world units along the shortest axis.
-    let step = 0.5 * volume.grid.min_spacing();
+    let (label, step) = (job.label, job.step);
     (0..rows * cols)
         .into_par_iter()
         .map(|i| {
@@ -298,7 +362,8 @@ mod tests {
     fn a_disc_gives_its_centroid_radius_and_distances() {
         // A disc of radius 0.4 lens units centred at (0.2, -0.1) on a square screen.
         let screen = Screen::new(200, 200);
-        let (cols, rows) = grid_size(screen);
+        let grid = FeatureGrid::of(screen);
+        let (cols, rows) = (grid.cols, grid.rows);
         let centre = Vec2::new(0.2, -0.1);
         let cell = 2.0 / rows as f32;
         let mask: Vec<bool> = (0..cols * rows)
@@ -307,7 +372,7 @@ mod tests {
                 (p - centre).length() < 0.4
             })
             .collect();
-        let f = FeatureField::from_mask(&mask, cols, rows, screen).unwrap();
+        let f = FeatureField::from_mask(&mask, grid, screen).unwrap();
         assert!((f.centroid - centre).length() < 0.01, "{}", f.centroid);
         assert!((f.equivalent_radius() - 0.4).abs() < 0.01, "{}", f.equivalent_radius());
         // Distances to the silhouette, inside and out, within a cell.
@@ -318,9 +383,9 @@ mod tests {
             let d = f.distance_at(s);
             assert!((d - want).abs() < 1.5 * cell, "{s}: {d} vs {want}");
         }
-        assert!(FeatureField::from_mask(&vec![false; mask.len()], cols, rows, screen).is_none());
+        assert!(FeatureField::from_mask(&vec![false; mask.len()], grid, screen).is_none());
         // A feature filling the view stays a finite field (a zoom into the feature).
-        let full = FeatureField::from_mask(&vec![true; mask.len()], cols, rows, screen).unwrap();
+        let full = FeatureField::from_mask(&vec![true; mask.len()], grid, screen).unwrap();
         assert!(full.distance.iter().all(|d| d.is_finite() && *d < 0.0));
         assert!(full.distance_at(Vec2::ZERO).is_finite() && full.distance_at(Vec2::new(3.0, 0.0)).is_finite());
     }
@@ -345,7 +410,9 @@ mod tests {
         assert_eq!(resolved.center, field.centroid);
         // A circular magnifier with the same centre covering the whole image: inside the
         // silhouette the feature lens bends rays exactly as its focus region does.
-        let cover = crate::lens::stack::resolve(&Lens::magnifier(field.centroid, 4.0, 0.0, 2.0), &cam, screen, scene.bounding_sphere());
+        // (A feature lens takes its focus depth on the view axis.)
+        let mut cover = crate::lens::stack::resolve(&Lens::magnifier(Vec2::ZERO, 4.0, 0.0, 2.0), &cam, screen, scene.bounding_sphere());
+        cover.center = field.centroid;
         let (mut inside, mut outside) = (0, 0);
         for py in (0..120).step_by(3) {
             for px in (0..120).step_by(3) {

@@ -13,7 +13,7 @@ use glam::{Vec2, Vec3};
 use std::sync::Arc;
 
 use super::angular::fisheye;
-use super::feature::{FeatureField, feature_mask, grid_size};
+use super::feature::{FeatureField, FeatureJob, feature_mask};
 use super::magnifier::Magnifier;
 use super::sampling::{TABLE_SIZE, lookup};
 use super::shape::Shape;
@@ -77,8 +77,19 @@ pub struct ResolvedLens {
     pub border: f32,
     pub shape: Shape,
     pub effect: Effect,
-    /// A feature lens's silhouette in this view.
+    /// A feature lens's silhouette in this view (found on the CPU).
     pub field: Option<Arc<FeatureField>>,
+    /// A feature lens's silhouette search; with no `field`, the GPU finds it and the
+    /// centre and radius here are placeholders.
+    pub job: Option<FeatureJob>,
+}
+
+/// Where feature lenses find their silhouettes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Silhouettes {
+    Cpu,
+    /// Left to the GPU's compute passes (the render pass).
+    Gpu,
 }
 
 /// Resolves `lens` for `camera`; `scene` is the bounding sphere of what is shown
@@ -102,25 +113,45 @@ pub fn resolve(lens: &Lens, camera: &Camera, screen: Screen, scene: (Vec3, f32))
         }
     };
     let center = if matches!(effect, Effect::Angular { whole_view: true, .. }) { Vec2::ZERO } else { lens.center };
-    ResolvedLens { center, radius, border: lens.border, shape: lens.shape.clone(), effect, field: None }
+    ResolvedLens { center, radius, border: lens.border, shape: lens.shape.clone(), effect, field: None, job: None }
 }
 
 /// Resolves `lens` for `camera` in `scene`: a feature lens finds its feature's
 /// silhouette ([`super::feature`]) and centres on it; `None` when its feature is not in
 /// view.
 pub fn resolve_in(lens: &Lens, camera: &Camera, screen: Screen, scene: &RenderScene) -> Option<ResolvedLens> {
+    resolve_with(lens, camera, screen, scene, Silhouettes::Cpu)
+}
+
+/// [`resolve_in`], leaving the silhouettes to the GPU when asked (`None` then only when
+/// no region shows the feature).
+pub fn resolve_with(lens: &Lens, camera: &Camera, screen: Screen, scene: &RenderScene, silhouettes: Silhouettes) -> Option<ResolvedLens> {
     let bounds = scene.bounding_sphere();
     let Shape::Feature(feature) = &lens.shape else { return Some(resolve(lens, camera, screen, bounds)) };
-    let (cols, rows) = grid_size(screen);
-    let field = FeatureField::from_mask(&feature_mask(scene, feature, camera, screen, cols, rows), cols, rows, screen)?;
-    let placed = Lens { center: field.centroid, radius: field.equivalent_radius(), shape: Shape::Circle, ..lens.clone() };
+    let job = FeatureJob::new(scene, feature, screen)?;
+    // The focus depth on the view axis: the centroid is not known yet.
+    let placed = Lens { center: Vec2::ZERO, shape: Shape::Circle, ..lens.clone() };
     let mut resolved = resolve(&placed, camera, screen, bounds);
     resolved.shape = lens.shape.clone();
-    resolved.field = Some(Arc::new(field));
-    Some(resolved)
+    resolved.job = Some(job);
+    match silhouettes {
+        Silhouettes::Gpu => Some(resolved),
+        Silhouettes::Cpu => resolved.with_silhouette(camera, screen, scene),
+    }
 }
 
 impl ResolvedLens {
+    /// This lens with its feature's silhouette found on the CPU when it was left to the
+    /// GPU (other lenses unchanged); `None` when the feature is not in view.
+    pub fn with_silhouette(mut self, camera: &Camera, screen: Screen, scene: &RenderScene) -> Option<ResolvedLens> {
+        let Some(job) = self.job.filter(|_| self.field.is_none()) else { return Some(self) };
+        let field = FeatureField::from_mask(&feature_mask(scene, &job, camera, screen), job.grid, screen)?;
+        self.center = field.centroid;
+        self.radius = field.equivalent_radius();
+        self.field = Some(Arc::new(field));
+        Some(self)
+    }
+
     /// Radial coordinate of offset `v` from the centre: the shape's, or for a feature
     /// `lr + d` with `d` the signed distance to its silhouette.
     pub fn radial(&self, v: Vec2) -> f32 {

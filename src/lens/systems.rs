@@ -4,7 +4,7 @@ use bevy::camera::CameraUpdateSystems;
 use bevy::prelude::*;
 
 use super::spec::Lens;
-use super::stack::{MAX_LENSES, ResolvedLens, Screen, resolve_in};
+use super::stack::{MAX_LENSES, ResolvedLens, Screen, Silhouettes, resolve_with};
 use crate::dataset::SceneRegions;
 use crate::region::{Camera as FocalCamera, Projection as FocalProjection};
 use crate::render::VolumeView;
@@ -15,6 +15,22 @@ pub struct ViewLenses {
     pub lenses: Vec<ResolvedLens>,
     pub camera: Option<FocalCamera>,
     pub screen: Option<Screen>,
+    /// Feature lenses were left to the GPU ([`VolumeView::gpu_silhouettes`]).
+    pub gpu_silhouettes: bool,
+}
+
+impl ViewLenses {
+    /// The lenses with every feature's silhouette found on the CPU (for overlays and
+    /// read-outs; a feature out of view drops out).
+    pub fn on_cpu(&self, scene: &crate::region::RenderScene) -> Vec<ResolvedLens> {
+        let (Some(camera), Some(screen)) = (self.camera, self.screen) else { return Vec::new() };
+        self.lenses.iter().filter_map(|l| l.clone().with_silhouette(&camera, screen, scene)).collect()
+    }
+
+    /// Whether a lens waits for the GPU's silhouette.
+    pub fn has_gpu_silhouettes(&self) -> bool {
+        self.lenses.iter().any(|l| l.job.is_some() && l.field.is_none())
+    }
 }
 
 /// The Focal camera of a Bevy camera (`None` for custom projections).
@@ -44,7 +60,7 @@ pub struct LensOrder(pub u32);
 /// scene changed (a feature lens computes its silhouette then).
 pub fn resolve_view_lenses(
     lenses: Query<(Entity, &Lens, Option<&LensOrder>)>,
-    mut views: Query<(&Camera, &GlobalTransform, &Projection, &mut ViewLenses), With<VolumeView>>,
+    mut views: Query<(&Camera, &GlobalTransform, &Projection, &VolumeView, &mut ViewLenses)>,
     scene: Res<SceneRegions>,
     mut last: Local<Vec<Lens>>,
 ) {
@@ -55,17 +71,20 @@ pub fn resolve_view_lenses(
     let current: Vec<Lens> = ordered.iter().map(|(_, l, _)| (*l).clone()).collect();
     let lenses_changed = *last != current;
     let mut all_resolved = true;
-    for (camera, transform, projection, mut view) in &mut views {
+    for (camera, transform, projection, volume_view, mut view) in &mut views {
         let (Some(cam), Some(size)) = (focal_camera(transform, projection), camera.physical_viewport_size()) else {
             all_resolved = false;
             continue;
         };
         let screen = Screen::new(size.x, size.y);
-        if !lenses_changed && !scene.is_changed() && view.camera == Some(cam) && view.screen == Some(screen) {
+        let gpu = volume_view.gpu_silhouettes;
+        if !lenses_changed && !scene.is_changed() && view.camera == Some(cam) && view.screen == Some(screen) && view.gpu_silhouettes == gpu
+        {
             continue;
         }
-        let resolved: Vec<ResolvedLens> = current.iter().filter_map(|l| resolve_in(l, &cam, screen, &scene.scene)).collect();
-        let next = ViewLenses { lenses: resolved, camera: Some(cam), screen: Some(screen) };
+        let silhouettes = if gpu { Silhouettes::Gpu } else { Silhouettes::Cpu };
+        let resolved: Vec<ResolvedLens> = current.iter().filter_map(|l| resolve_with(l, &cam, screen, &scene.scene, silhouettes)).collect();
+        let next = ViewLenses { lenses: resolved, camera: Some(cam), screen: Some(screen), gpu_silhouettes: gpu };
         if *view != next {
             *view = next;
         }

@@ -23,6 +23,8 @@ pub struct VolumeView {
     pub debug_rays: bool,
     /// Under lenses, sample compressed areas from the mip chain (`lens::antialias`).
     pub lens_antialias: bool,
+    /// Feature lenses find their silhouettes in compute passes (else on the CPU).
+    pub gpu_silhouettes: bool,
     /// Seed of the jitter pattern.
     pub frame: u32,
     /// Light of the view (copied from the scene each frame).
@@ -37,6 +39,7 @@ impl Default for VolumeView {
             early_termination: true,
             debug_rays: false,
             lens_antialias: true,
+            gpu_silhouettes: true,
             frame: 0,
             light: Light::Headlight,
         }

@@ -203,6 +203,12 @@ impl Offscreen {
 
     /// Average wall-clock time of `frames` frames (after the scene settled).
     pub fn time_frames(&mut self, frames: u32) -> Duration {
+        self.time_frames_with(frames, |_, _| {})
+    }
+
+    /// [`Self::time_frames`], calling `before(self, k)` ahead of frame `k` (to move the
+    /// camera, say).
+    pub fn time_frames_with(&mut self, frames: u32, mut before: impl FnMut(&mut Self, u32)) -> Duration {
         for _ in 0..MAX_WAIT_FRAMES {
             self.update();
             if self.ready() {
@@ -210,7 +216,8 @@ impl Offscreen {
             }
         }
         let t = Instant::now();
-        for _ in 0..frames.max(1) {
+        for k in 0..frames.max(1) {
+            before(self, k);
             self.update();
         }
         t.elapsed() / frames.max(1)

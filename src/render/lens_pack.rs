@@ -5,21 +5,41 @@
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponent;
 use bevy::render::sync_component::SyncComponent;
-use glam::{UVec4, Vec4};
+use glam::{UVec4, Vec2, Vec4};
 
 use super::gpu_types::{GpuLens, GpuSettings, lens_codes};
+use crate::lens::feature::{FIELD_HEADER, FeatureGrid, FeatureJob};
 use crate::lens::shape::Shape;
 use crate::lens::stack::Effect;
 use crate::lens::{MAX_LENSES, ResolvedLens, ViewLenses};
 
-/// The signed distance fields of a view's feature lenses, one after another in lens
-/// order (each lens's data holds its offset).
+/// The silhouettes of a view's feature lenses, one after another in lens order (each
+/// lens's data holds its offset): a header ([`FIELD_HEADER`]) and the signed distances.
+/// Those the CPU found are in `values`; the others are zeros there and `jobs` (offset,
+/// job) for the compute passes to fill.
 #[derive(Component, Clone, Debug, Default, PartialEq)]
-pub struct GpuFeatureFields(pub Vec<f32>);
+pub struct GpuFeatureFields {
+    pub values: Vec<f32>,
+    pub jobs: Vec<(u32, FeatureJob)>,
+}
 
 /// The silhouettes of `lenses`, concatenated.
-pub fn feature_data(lenses: &[ResolvedLens]) -> Vec<f32> {
-    lenses.iter().take(MAX_LENSES).filter_map(|l| l.field.as_ref()).flat_map(|f| f.distance.iter().copied()).collect()
+pub fn feature_data(lenses: &[ResolvedLens]) -> GpuFeatureFields {
+    let mut out = GpuFeatureFields::default();
+    for lens in lenses.iter().take(MAX_LENSES) {
+        match (&lens.field, &lens.job) {
+            (Some(field), _) => {
+                out.values.extend(field.header());
+                out.values.extend(&field.distance);
+            }
+            (None, Some(job)) => {
+                out.jobs.push((out.values.len() as u32, *job));
+                out.values.resize(out.values.len() + FIELD_HEADER + job.grid.cells(), 0.0);
+            }
+            (None, None) => {}
+        }
+    }
+    out
 }
 
 impl SyncComponent for ViewLenses {
@@ -32,7 +52,7 @@ impl ExtractComponent for ViewLenses {
     type Out = GpuFeatureFields;
 
     fn extract_component(lenses: &ViewLenses) -> Option<GpuFeatureFields> {
-        Some(GpuFeatureFields(feature_data(&lenses.lenses)))
+        Some(feature_data(&lenses.lenses))
     }
 }
 
@@ -42,11 +62,13 @@ pub fn pack_lenses(settings: &mut GpuSettings, lenses: &[ResolvedLens]) {
     let mut field_offset = 0usize;
     for (i, lens) in lenses.iter().take(MAX_LENSES).enumerate() {
         let data = &mut settings.lens_data[i * lens_codes::DATA_PER_LENS..(i + 1) * lens_codes::DATA_PER_LENS];
-        let (shape, vertices) = match (&lens.shape, &lens.field) {
-            (_, Some(field)) => {
-                data[0] = Vec4::new(field.cols as f32, field.rows as f32, field.origin.x, field.origin.y);
-                data[1] = Vec4::new(field.cell_x(), field.cell, field_offset as f32, 0.0);
-                field_offset += field.distance.len();
+        let grid =
+            lens.field.as_ref().map(|f| FeatureGrid { cols: f.cols, rows: f.rows, origin: f.origin, step: Vec2::new(f.cell_x(), f.cell) });
+        let (shape, vertices) = match (&lens.shape, grid.or(lens.job.map(|j| j.grid))) {
+            (_, Some(grid)) => {
+                data[0] = Vec4::new(grid.cols as f32, grid.rows as f32, grid.origin.x, grid.origin.y);
+                data[1] = Vec4::new(grid.step.x, grid.step.y, field_offset as f32, 0.0);
+                field_offset += FIELD_HEADER + grid.cells();
                 (lens_codes::FEATURE, 0)
             }
             (Shape::Circle | Shape::Feature(_), None) => (lens_codes::CIRCLE, 0),

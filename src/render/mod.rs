@@ -15,6 +15,7 @@
 //! business (datasets, windows, exploded parts), expressed as regions.
 
 pub mod extract;
+pub mod feature_pass;
 pub mod gpu_types;
 pub mod headless;
 pub mod lens_pack;
@@ -87,11 +88,12 @@ impl Plugin for VolumeRenderPlugin {
             .init_resource::<upload::GpuScene>()
             .init_resource::<bevy::render::render_resource::SpecializedRenderPipelines<pipeline::RaycastPipeline>>()
             .add_systems(bevy::render::ExtractSchedule, extract::extract_scene)
-            .add_systems(RenderStartup, pipeline::init_pipeline)
+            .add_systems(RenderStartup, (pipeline::init_pipeline, feature_pass::init_feature_pipelines))
             .add_systems(
                 Render,
                 (
                     upload::upload_scene.in_set(RenderSystems::PrepareResources),
+                    feature_pass::prepare_feature_buffers.in_set(RenderSystems::PrepareResources).after(upload::upload_scene),
                     pipeline::prepare_pipelines.in_set(RenderSystems::Prepare),
                     record_pipeline_state.in_set(RenderSystems::Cleanup),
                 ),

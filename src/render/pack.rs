@@ -43,6 +43,8 @@ pub struct PackedScene {
     pub brick_atlas: Atlas,
     /// Regions left out, with the reason (the atlas is full).
     pub dropped: Vec<String>,
+    /// Index in `regions` of every scene region (`None` for those dropped).
+    pub region_slots: Vec<Option<u32>>,
     /// Shader features the regions need ([`super::gpu_types::features`]).
     pub features: u32,
 }
@@ -148,7 +150,11 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         next += count;
     }
     for p in &prepared {
-        let Some(slot) = out.volumes.iter().position(|&v| v == p.region.volume) else { continue };
+        let Some(slot) = out.volumes.iter().position(|&v| v == p.region.volume) else {
+            out.region_slots.push(None);
+            continue;
+        };
+        out.region_slots.push(Some(out.regions.len() as u32));
         let levels = out.levels[slot].clone();
         let region = pack_region(p, &levels, out.brick_atlas.offsets[slot], &mut out);
         out.regions.push(region);
@@ -325,6 +331,8 @@ mod tests {
         let packed = pack(&scene, 12).unwrap();
         assert_eq!(packed.regions.len(), 1);
         assert_eq!(packed.dropped.len(), 2);
+        assert_eq!(packed.region_slots.iter().filter(|s| s.is_none()).count(), 2);
+        assert_eq!(packed.region_slots.iter().flatten().count(), packed.regions.len());
         // DVR regions carry their occupancy bits.
         assert!(packed.regions.iter().all(|r| r.flags & region_flags::OCCUPANCY != 0));
     }

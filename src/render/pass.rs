@@ -7,8 +7,8 @@ use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, ViewQuery};
 use bevy::render::view::{ViewDepthTexture, ViewTarget, ViewUniformOffset, ViewUniforms};
 
+use super::feature_pass::{FeatureBuffers, FeaturePipelines, encode_feature_passes};
 use super::gpu_types::GpuSettings;
-use super::lens_pack::GpuFeatureFields;
 use super::pipeline::{RaycastPipeline, RaycastPipelineId};
 use super::upload::GpuScene;
 
@@ -21,9 +21,10 @@ pub fn raycast_pass(
         &DynamicUniformIndex<GpuSettings>,
         &RaycastPipelineId,
         Option<&ExtractedCamera>,
-        Option<&GpuFeatureFields>,
+        Option<&FeatureBuffers>,
     )>,
     pipeline: Res<RaycastPipeline>,
+    feature_pipelines: Res<FeaturePipelines>,
     cache: Res<PipelineCache>,
     view_uniforms: Res<ViewUniforms>,
     settings: Res<ComponentUniforms<GpuSettings>>,
@@ -45,14 +46,11 @@ pub fn raycast_pass(
     else {
         return;
     };
-    // The feature lenses' silhouettes (one unused value when there are none).
-    let fields: &[f32] = fields.map(|f| f.0.as_slice()).filter(|f| !f.is_empty()).unwrap_or(&[0.0]);
-    let field_bytes: Vec<u8> = fields.iter().flat_map(|v| v.to_le_bytes()).collect();
-    let field_buffer = ctx.render_device().create_buffer_with_data(&BufferInitDescriptor {
-        label: Some("focal feature fields"),
-        contents: &field_bytes,
-        usage: BufferUsages::STORAGE,
-    });
+    // The feature lenses' silhouettes, found first where the GPU finds them.
+    let Some(fields) = fields else { return };
+    if !encode_feature_passes(&mut ctx, fields, &feature_pipelines, &cache, &scene, (view_binding.clone(), view_offset.offset)) {
+        return;
+    }
     let bind_group = ctx.render_device().create_bind_group(
         "focal_raycast_bind_group",
         &cache.get_bind_group_layout(&pipeline.layout),
@@ -68,7 +66,7 @@ pub fn raycast_pass(
             &atlases.bricks,
             &pipeline.sampler,
             depth.view(),
-            field_buffer.as_entire_binding(),
+            fields.fields.as_entire_binding(),
         )),
     );
     let mut pass = ctx.command_encoder().begin_render_pass(&RenderPassDescriptor {

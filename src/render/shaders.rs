@@ -9,8 +9,11 @@ use bevy::shader::Shader;
 /// The ray-cast fragment shader.
 pub const RAYCAST: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a11");
 
+/// The compute shader of the feature lenses' silhouettes.
+pub const FEATURE: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a12");
+
 /// (fixed handle, file name, source) of every shader.
-const SHADERS: [(Handle<Shader>, &str, &str); 10] = [
+const SHADERS: [(Handle<Shader>, &str, &str); 11] = [
     (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a01"), "shaders/focal/types.wgsl", include_str!("../../shaders/focal/types.wgsl")),
     (
         uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a02"),
@@ -37,6 +40,7 @@ const SHADERS: [(Handle<Shader>, &str, &str); 10] = [
     ),
     (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a09"), "shaders/focal/lens.wgsl", include_str!("../../shaders/focal/lens.wgsl")),
     (RAYCAST, "shaders/raycast.wgsl", include_str!("../../shaders/raycast.wgsl")),
+    (FEATURE, "shaders/feature.wgsl", include_str!("../../shaders/feature.wgsl")),
 ];
 
 /// Inserts every shader into `Assets<Shader>`.

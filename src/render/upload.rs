@@ -38,6 +38,8 @@ pub struct GpuScene {
     pub occupancy: Option<Buffer>,
     pub lut: Option<(Texture, TextureView)>,
     pub region_count: u32,
+    /// GPU region index of every scene region (`None`: dropped).
+    pub region_slots: Vec<Option<u32>>,
     /// Shader features the scene needs.
     pub features: u32,
     /// Messages about regions that could not be drawn.
@@ -97,6 +99,7 @@ pub fn upload_scene(
     gpu.region_count = packed.regions.len() as u32;
     gpu.features = packed.features;
     gpu.dropped = packed.dropped;
+    gpu.region_slots = packed.region_slots;
     gpu.last = Some(scene.clone());
 }
 

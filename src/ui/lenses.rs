@@ -21,7 +21,7 @@ use crate::lens::handles::{self, Handle};
 use crate::lens::lattice::{lattice, round_spacing};
 use crate::lens::sampling::MAX_CUSTOM_SAMPLES;
 use crate::lens::systems::LensOrder;
-use crate::lens::{Lens, LensKind, MAX_LENSES, Profile, Sampling, Screen, Shape, ViewLenses, local_magnification};
+use crate::lens::{Lens, LensKind, MAX_LENSES, Profile, ResolvedLens, Sampling, Screen, Shape, ViewLenses, local_magnification};
 
 /// Pixels within which a rim grabs.
 const GRAB_PIXELS: f32 = 6.0;
@@ -42,6 +42,26 @@ pub struct LensUi {
     /// The lattice last computed, with the view lenses and scene bounds it was
     /// computed for.
     lattice: Option<((ViewLenses, (Vec3, f32)), Vec<[Vec2; 2]>)>,
+    /// The view lenses with their silhouettes found on the CPU, for the overlays (the
+    /// render finds them on the GPU), and the view lenses they were found for.
+    on_cpu: Option<(ViewLenses, Vec<ResolvedLens>)>,
+}
+
+impl LensUi {
+    /// The lenses of `view` with every silhouette known (cached until the view changes).
+    fn overlay_lenses(&mut self, view: &ViewLenses, regions: &SceneRegions) -> Vec<ResolvedLens> {
+        if !view.has_gpu_silhouettes() {
+            return view.lenses.clone();
+        }
+        if let Some((key, lenses)) = &self.on_cpu
+            && key == view
+        {
+            return lenses.clone();
+        }
+        let lenses = view.on_cpu(&regions.scene);
+        self.on_cpu = Some((view.clone(), lenses.clone()));
+        lenses
+    }
 }
 
 impl Default for LensUi {
@@ -55,6 +75,7 @@ impl Default for LensUi {
             show_lattice: false,
             show_readout: true,
             lattice: None,
+            on_cpu: None,
         }
     }
 }
@@ -415,7 +436,8 @@ pub fn overlay(ctx: &egui::Context, free: Rect, params: &mut LensParams, regions
                 crate::region::Projection::Perspective { fov_y } => 2.0 * depth * (fov_y * 0.5).tan(),
                 crate::region::Projection::Orthographic { height } => height,
             };
-            let segments = lattice(&cam, vs, &view.lenses, depth, round_spacing(view_height, 16.0), 6.0);
+            let lenses = params.ui.overlay_lenses(view, regions);
+            let segments = lattice(&cam, vs, &lenses, depth, round_spacing(view_height, 16.0), 6.0);
             params.ui.lattice = Some(((view.clone(), bounds), segments));
         }
         if let Some((_, segments)) = &params.ui.lattice {
@@ -477,7 +499,8 @@ pub fn overlay(ctx: &egui::Context, free: Rect, params: &mut LensParams, regions
         let (px, py) = ((p.x - free.left()) * k, (p.y - free.top()) * k);
         let (centre, radius) = regions.scene.bounding_sphere();
         let depth = (centre - cam.position).dot(cam.forward()).max(radius * 0.05);
-        if let Some(m) = local_magnification(&cam, vs, &view.lenses, px, py, depth) {
+        let lenses = params.ui.overlay_lenses(view, regions);
+        if let Some(m) = local_magnification(&cam, vs, &lenses, px, py, depth) {
             painter.text(
                 p + vec2(14.0, 14.0),
                 egui::Align2::LEFT_TOP,

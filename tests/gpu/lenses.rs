@@ -266,11 +266,24 @@ pub fn feature_lens_matches_the_reference(gpu: &mut Gpu) {
     for ortho in [false, true] {
         let cam = framed(&v, View::Anterior, ortho);
         let lens = Lens { shape: Shape::Feature(ventricles.clone()), ..Lens::magnifier(Vec2::ZERO, 0.3, 0.15, 2.5) };
-        let g = show_lensed(gpu, v.clone(), a.clone(), &cam, std::slice::from_ref(&lens));
+        set_lenses(gpu, std::slice::from_ref(&lens));
+        let g = gpu.show(v.clone(), a.clone(), &cam);
+        // The silhouette came from the compute passes (jump flooding), not the CPU.
+        let world = gpu.off.world_mut();
+        let views: Vec<focal::lens::ViewLenses> = world.query::<&focal::lens::ViewLenses>().iter(world).cloned().collect();
+        assert!(!views.is_empty() && views.iter().all(|v| v.has_gpu_silhouettes()), "feature lenses left to the GPU");
+        // A label nobody has: the passes find no silhouette and the lens stays off.
+        let absent = Lens { shape: Shape::Feature(focal::lens::feature::FeatureRef { label: 200, region: None }), ..lens.clone() };
+        set_lenses(gpu, &[absent]);
+        let none = gpu.show(v.clone(), a.clone(), &cam);
+        set_lenses(gpu, &[]);
         let c = cpu_lensed(v.clone(), a.clone(), &cam, std::slice::from_ref(&lens));
         let plain = gpu.show(v.clone(), a.clone(), &cam);
         assert_matches(&format!("lens_feature{}", if ortho { "_ortho" } else { "" }), &g, &c);
         let changed = g.pixels().zip(plain.pixels()).filter(|(p, q)| (0..3).any(|k| p[k].abs_diff(q[k]) > 10)).count();
         assert!(changed > 50, "the feature lens changed only {changed} pixels");
+        // (Rays from the eye under lenses, from the near plane without: not bit-equal.)
+        let bent = none.pixels().zip(plain.pixels()).filter(|(p, q)| (0..3).any(|k| p[k].abs_diff(q[k]) > 10)).count();
+        assert_eq!(bent, 0, "a feature out of view bends no ray");
     }
 }
