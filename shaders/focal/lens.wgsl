@@ -277,7 +277,11 @@ fn spread_extent(s: Spread, z: f32) -> f32 {
     return sqrt(max(0.5 * (a + c) + sqrt(h * h + b * b), 0.0));
 }
 
-// Prepares the pixel's footprint (no anti-aliasing where a neighbour has no ray).
+// The backward differences (pixel minus its left and upper neighbours), px qx py qy.
+var<private> backward_deltas: array<vec3<f32>, 4>;
+
+// Prepares the pixel's footprint (no anti-aliasing where a right or lower neighbour
+// has no ray; forward differences only where a left or upper one has none).
 fn lens_footprint(uv: vec2<f32>, ray: Ray) {
     let px = vec2(1.0 / view.viewport.z, 0.0);
     let py = vec2(0.0, 1.0 / view.viewport.w);
@@ -288,7 +292,34 @@ fn lens_footprint(uv: vec2<f32>, ray: Ray) {
     }
     lensed_spread = spread_of(ray, rx, ry);
     plain_spread = spread_of(camera_ray(uv), camera_ray(uv + px), camera_ray(uv + py));
+    backward_deltas = array<vec3<f32>, 4>(lensed_spread.px, lensed_spread.qx, lensed_spread.py, lensed_spread.qy);
+    let bx = lens_ray(uv - px);
+    let by = lens_ray(uv - py);
+    if dot(bx.dir, bx.dir) > 0.0 && dot(by.dir, by.dir) > 0.0 {
+        let b = spread_of(ray, bx, by);
+        backward_deltas = array<vec3<f32>, 4>(-b.px, -b.qx, -b.py, -b.qy);
+    }
     has_footprint = true;
+}
+
+// Longer of |p + q·z| at the two depths.
+fn reach(p: vec3<f32>, q: vec3<f32>, z0: f32, z1: f32) -> f32 {
+    return max(length(p + q * z0), length(p + q * z1));
+}
+
+// Per axis the one-sided difference smaller over [t0, t1] (reference:
+// Footprint::over): no footprint across a jump of the lens map.
+fn choose_sides(t0: f32, t1: f32) {
+    let z0 = lensed_spread.depth_start + lensed_spread.depth_per_t * t0;
+    let z1 = lensed_spread.depth_start + lensed_spread.depth_per_t * t1;
+    if reach(backward_deltas[0], backward_deltas[1], z0, z1) < reach(lensed_spread.px, lensed_spread.qx, z0, z1) {
+        lensed_spread.px = backward_deltas[0];
+        lensed_spread.qx = backward_deltas[1];
+    }
+    if reach(backward_deltas[2], backward_deltas[3], z0, z1) < reach(lensed_spread.py, lensed_spread.qy, z0, z1) {
+        lensed_spread.py = backward_deltas[2];
+        lensed_spread.qy = backward_deltas[3];
+    }
 }
 
 // Mip level at ray parameter t.
@@ -312,7 +343,11 @@ fn lod_at(t: f32) -> f32 {
 // their ratio is quasi-convex and its maximum over the interval lies at an end. Level 0
 // at both ends means level 0 throughout: the per-sample work is skipped (exactly).
 fn restrict_footprint(t0: f32, t1: f32) {
-    if has_footprint && lod_at(t0) <= 0.0 && lod_at(t1) <= 0.0 {
+    if !has_footprint {
+        return;
+    }
+    choose_sides(t0, t1);
+    if lod_at(t0) <= 0.0 && lod_at(t1) <= 0.0 {
         has_footprint = false;
     }
 }

@@ -27,6 +27,13 @@
 //! is quasi-convex: over a ray's interval its maximum lies at an end. Where the level is
 //! 0 at both ends of the interval it is 0 throughout, and the shader skips the
 //! per-sample work for that pixel (an exact shortcut; [`Footprint::level_free`]).
+//!
+//! Where the lens map jumps (the rim of a simple-profile magnifier, of an angular lens)
+//! the difference across the jump is no footprint: it would blur a seam along the rim.
+//! So each axis takes the one-sided difference, forward (right, lower neighbour) or
+//! backward (left, upper), that is smaller over the ray's interval `[t0, t1]`
+//! ([`Footprint::over`]; `|Δ(z)|` is convex in `z`, so its maximum is at an end). The
+//! chosen spread is again affine in `z`, so the shortcut above stays exact.
 
 use glam::Vec3;
 
@@ -80,6 +87,9 @@ impl Spread {
 pub struct Footprint {
     pub lensed: Spread,
     pub plain: Spread,
+    /// The lensed backward differences `Δp_x, Δq_x, Δp_y, Δq_y` (pixel minus its left
+    /// and upper neighbours).
+    pub backward: [Vec3; 4],
 }
 
 impl Footprint {
@@ -88,10 +98,31 @@ impl Footprint {
     pub fn new(camera: &Camera, screen: Screen, lenses: &[ResolvedLens], px: f32, py: f32) -> Option<Footprint> {
         let lensed = |x: f32, y: f32| lens_ray(camera, screen, lenses, x, y);
         let plain = |x: f32, y: f32| camera.ray(x, y, screen.width as u32, screen.height as u32);
-        Some(Footprint {
-            lensed: Spread::of(camera, lensed(px, py)?, lensed(px + 1.0, py)?, lensed(px, py + 1.0)?),
-            plain: Spread::of(camera, plain(px, py), plain(px + 1.0, py), plain(px, py + 1.0)),
-        })
+        let r = lensed(px, py)?;
+        let forward = Spread::of(camera, r, lensed(px + 1.0, py)?, lensed(px, py + 1.0)?);
+        // Without a left or upper neighbour's ray, the forward differences.
+        let backward = match (lensed(px - 1.0, py), lensed(px, py - 1.0)) {
+            (Some(bx), Some(by)) => Spread::of(camera, r, bx, by).deltas.map(|d| -d),
+            _ => forward.deltas,
+        };
+        Some(Footprint { lensed: forward, plain: Spread::of(camera, plain(px, py), plain(px + 1.0, py), plain(px, py + 1.0)), backward })
+    }
+
+    /// The footprint for the interval `[t0, t1]` of the lensed ray: per axis the
+    /// one-sided difference that is smaller over it (see the module docs).
+    pub fn over(&self, t0: f32, t1: f32) -> Footprint {
+        let s = &self.lensed;
+        let (z0, z1) = (s.depth0 + s.depth_per_t * t0, s.depth0 + s.depth_per_t * t1);
+        let reach = |p: Vec3, q: Vec3| (p + q * z0).length().max((p + q * z1).length());
+        let mut deltas = s.deltas;
+        for axis in [0, 2] {
+            let (f, b) = ((s.deltas[axis], s.deltas[axis + 1]), (self.backward[axis], self.backward[axis + 1]));
+            if reach(b.0, b.1) < reach(f.0, f.1) {
+                deltas[axis] = b.0;
+                deltas[axis + 1] = b.1;
+            }
+        }
+        Footprint { lensed: Spread { deltas, ..*s }, ..*self }
     }
 
     /// Magnification `mf` in the most compressed direction at parameter `t` of the
@@ -216,8 +247,11 @@ mod tests {
                 let resolved = [resolve(&lens, &cam, screen, (Vec3::ZERO, 100.0))];
                 for py in (3..120).step_by(9) {
                     for px in (3..120).step_by(9) {
-                        let Some(f) = Footprint::new(&cam, screen, &resolved, px as f32, py as f32) else { continue };
                         let (t0, t1) = (200.0, 500.0);
+                        // The sides chosen for the interval, as the renderers do.
+                        let Some(f) = Footprint::new(&cam, screen, &resolved, px as f32, py as f32).map(|f| f.over(t0, t1)) else {
+                            continue;
+                        };
                         let ends = f.magnification(t0).min(f.magnification(t1));
                         for k in 1..30 {
                             let t = t0 + (t1 - t0) * k as f32 / 30.0;
@@ -245,6 +279,38 @@ mod tests {
             let f = Footprint::new(&cam, screen, &resolved, 169.5, 100.0).unwrap();
             let t = f.lensed.t_at_depth(500.0);
             assert!(f.level(t, 3.0) < 0.1, "{projection:?}: level {}", f.level(t, 3.0));
+        }
+    }
+
+    #[test]
+    fn a_jump_of_the_lens_map_is_no_footprint() {
+        // A simple-profile magnifier jumps from ×2 to ×1 at its rim, 40 pixels from the
+        // centre: pixel 139.5 is inside, its right neighbour outside. The forward
+        // difference spans the jump; the backward one (inside) is the footprint.
+        let screen = Screen::new(200, 200);
+        let lens = Lens {
+            kind: LensKind::Magnifier { magnification: 2.0, profile: crate::lens::Profile::Simple, focus_depth: None, plane_depth: None },
+            ..Lens::magnifier(Vec2::ZERO, 0.4, 0.2, 2.0)
+        };
+        for projection in [Projection::Perspective { fov_y: 0.6 }, Projection::Orthographic { height: 200.0 }] {
+            let cam = Camera::look_at(Vec3::new(0.0, 0.0, 500.0), Vec3::ZERO, Vec3::Y, projection);
+            let resolved = [resolve(&lens, &cam, screen, (Vec3::ZERO, 100.0))];
+            for (px, py) in [(139.5, 100.0), (100.0, 139.5), (60.5, 100.0)] {
+                let f = Footprint::new(&cam, screen, &resolved, px, py).unwrap();
+                let (t0, t1) = (f.lensed.t_at_depth(400.0), f.lensed.t_at_depth(600.0));
+                let t = f.lensed.t_at_depth(500.0);
+                let chosen = f.over(t0, t1);
+                assert!(chosen.level(t, 3.0) < 1e-3, "{projection:?} ({px}, {py}): level {}", chosen.level(t, 3.0));
+                assert!(chosen.magnification(t) > 1.5, "{projection:?}: inside, mf {}", chosen.magnification(t));
+                if px > 100.0 {
+                    // Forward differences alone blur the rim.
+                    assert!(f.level(t, 3.0) > 1.0, "{projection:?} ({px}, {py}): forward level {}", f.level(t, 3.0));
+                }
+            }
+            // Where the map is smooth both sides agree.
+            let f = Footprint::new(&cam, screen, &resolved, 100.0, 100.0).unwrap();
+            let t = f.lensed.t_at_depth(500.0);
+            assert!((f.over(f.lensed.t_at_depth(400.0), f.lensed.t_at_depth(600.0)).magnification(t) - f.magnification(t)).abs() < 0.05);
         }
     }
 }

@@ -110,6 +110,7 @@ pub fn trace_antialiased(
     if !t_start.is_finite() {
         return out;
     }
+    let footprint = footprint.map(|f| f.over(t_start, t_end));
     for (st, r) in states.iter_mut().zip(regions) {
         if let Some(st) = st {
             st.ratio = r.native_step * (step / r.world_step(ray.dir)) / r.reference_length;
