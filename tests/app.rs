@@ -41,7 +41,9 @@ fn files_load_in_the_background_and_failures_keep_the_data() {
     run_until(&mut app, |w| !dataset_names(w).is_empty());
     assert_eq!(dataset_names(app.world_mut()), vec!["fuel"]);
     let session = app.world().resource::<Session>();
-    assert!(session.error.is_none() && session.reframe.is_some());
+    assert!(session.error.is_none());
+    // A plain data file gets a standard view.
+    assert!(session.reframe.as_ref().is_some_and(|r| r.camera.is_none()));
 
     // A broken file: an error to show, and the fuel data stays.
     let dir = scratch("app-bad");
@@ -68,6 +70,10 @@ fn scene_files_load_with_all_their_datasets() {
     let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/ch2_aal.ron");
     app.world_mut().write_message(LoadRequest::Path(scene));
     run_until(&mut app, |w| dataset_names(w).len() == 2);
+    // The camera is the scene's own.
+    let session = app.world().resource::<Session>();
+    let own = session.scene.as_ref().map(|s| s.camera.clone());
+    assert!(own.is_some() && session.reframe.as_ref().map(|r| r.camera.clone()) == Some(own));
     // The scene's regions follow: one per visible dataset.
     app.update();
     assert_eq!(app.world().resource::<focal::dataset::SceneRegions>().scene.regions.len(), 2);

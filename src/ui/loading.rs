@@ -30,7 +30,15 @@ pub struct Session {
     /// The last load error, shown until dismissed.
     pub error: Option<String>,
     /// Set when new data arrived: the camera should frame it.
-    pub reframe: Option<(Vec3, Vec3)>,
+    pub reframe: Option<Reframe>,
+}
+
+/// How to place the camera on new data: the visible bounds, and a scene file's own
+/// camera (a plain data file gets a standard oblique view).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reframe {
+    pub bounds: (Vec3, Vec3),
+    pub camera: Option<crate::scene::file::CameraSpec>,
 }
 
 /// What a finished load brings: the scene, the folder of its relative paths, the
@@ -144,7 +152,7 @@ pub fn finish_loads(
                     ));
                 }
                 light.0 = scene.light;
-                session.reframe = Some(visible_bounds(&datasets));
+                session.reframe = Some(Reframe { bounds: visible_bounds(&datasets), camera: is_scene.then(|| scene.camera.clone()) });
                 session.scene = Some(scene);
                 session.base = base;
                 session.error = None;

@@ -26,7 +26,7 @@ use bevy_egui::{EguiGlobalSettings, EguiPlugin, EguiPrimaryContextPass, PrimaryE
 use crate::dataset::SceneRegions;
 use crate::region::View;
 use crate::render::VolumeView;
-use loading::{LoadRequest, LoadingPlugin, Session};
+use loading::{LoadRequest, LoadingPlugin, Reframe, Session};
 use orbit::{OrbitCamera, PointerInViewport};
 
 /// Keyboard shortcuts, as listed in the help panel.
@@ -298,11 +298,14 @@ pub fn scene_bounds(regions: &SceneRegions) -> (Vec3, Vec3) {
 }
 
 /// Frames newly loaded data.
-fn reframe(mut session: ResMut<Session>, mut cams: Query<&mut OrbitCamera>) {
-    if let Some((lo, hi)) = session.reframe.take()
-        && let Ok(mut orbit) = cams.single_mut()
-    {
-        orbit.frame(View::Oblique, lo, hi, 1.0);
+/// Places the camera on newly loaded data: a scene's own camera, else an oblique view.
+fn reframe(mut session: ResMut<Session>, mut cams: Query<(&mut OrbitCamera, &Camera), With<MainCamera>>) {
+    let Ok((mut orbit, camera)) = cams.single_mut() else { return };
+    let Some(Reframe { bounds: (lo, hi), camera: spec }) = session.reframe.take() else { return };
+    let aspect = camera.physical_viewport_size().map_or(1.0, |s| s.x as f32 / s.y.max(1) as f32);
+    match spec {
+        Some(spec) => orbit.set_from(&crate::scene::load::camera(&spec, (lo, hi), aspect), (lo + hi) * 0.5),
+        None => orbit.frame(View::Oblique, lo, hi, aspect),
     }
 }
 

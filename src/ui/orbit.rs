@@ -111,6 +111,30 @@ impl OrbitCamera {
         self.azimuth_deg = (-dir.x).atan2(dir.y).to_degrees().rem_euclid(360.0);
     }
 
+    /// Takes the pose and projection of `cam` (a scene's camera), orbiting about the
+    /// point of its view axis nearest to `centre`. The orbit keeps +z up: a rolled
+    /// camera loses its roll.
+    pub fn set_from(&mut self, cam: &FocalCamera, centre: Vec3) {
+        let forward = cam.forward();
+        let along = (centre - cam.position).dot(forward);
+        let distance = if along > 1e-3 { along } else { (centre - cam.position).length().max(1.0) };
+        self.target = cam.position + forward * distance;
+        self.distance = distance;
+        let dir = -forward;
+        self.elevation_deg = dir.z.clamp(-1.0, 1.0).asin().to_degrees().clamp(-89.0, 89.0);
+        self.azimuth_deg = (-dir.x).atan2(dir.y).to_degrees().rem_euclid(360.0);
+        match cam.projection {
+            FocalProjection::Perspective { fov_y } => {
+                self.orthographic = false;
+                self.fov_deg = fov_y.to_degrees();
+            }
+            FocalProjection::Orthographic { height } => {
+                self.orthographic = true;
+                self.fov_deg = (2.0 * (height * 0.5 / distance).atan()).to_degrees();
+            }
+        }
+    }
+
     /// The Bevy transform and projection of this camera.
     pub fn bevy(&self) -> (Transform, Projection) {
         let cam = self.camera();
@@ -262,6 +286,40 @@ mod tests {
         p.frame(View::Left, Vec3::splat(-10.0), Vec3::splat(10.0), 1.0);
         assert!(p.target.length() < 1e-5);
         assert!((p.azimuth_deg - 90.0).abs() < 1e-3 && p.elevation_deg.abs() < 1e-3, "{} {}", p.azimuth_deg, p.elevation_deg);
+    }
+
+    #[test]
+    fn a_scene_camera_becomes_the_orbit() {
+        // An orbit's own camera round-trips, perspective and orthographic.
+        for orthographic in [false, true] {
+            let o = OrbitCamera {
+                target: Vec3::new(5.0, -3.0, 2.0),
+                azimuth_deg: 70.0,
+                elevation_deg: 25.0,
+                distance: 240.0,
+                orthographic,
+                ..Default::default()
+            };
+            let mut p = OrbitCamera::default();
+            p.set_from(&o.camera(), o.target + Vec3::new(0.0, 0.0, 0.0));
+            let (a, b) = (o.camera(), p.camera());
+            assert!((a.position - b.position).length() < 1e-2, "{} vs {}", a.position, b.position);
+            assert!(a.rotation.angle_between(b.rotation) < 1e-3);
+            assert_eq!(a.projection, b.projection);
+        }
+        // A scene's look-at camera from the front, at 300 from a centre it looks past:
+        // the orbit pivots on the view axis at the centre's depth, same eye and view.
+        let cam = FocalCamera::look_at(
+            Vec3::new(0.0, 300.0, 0.0),
+            Vec3::new(10.0, 0.0, 0.0),
+            Vec3::Z,
+            FocalProjection::Perspective { fov_y: 0.5 },
+        );
+        let mut p = OrbitCamera::default();
+        p.set_from(&cam, Vec3::ZERO);
+        assert!((p.camera().position - cam.position).length() < 1e-2);
+        assert!(p.camera().forward().dot(cam.forward()) > 0.99999);
+        assert!((p.fov_deg - 0.5f32.to_degrees()).abs() < 1e-4 && !p.orthographic);
     }
 
     #[test]
