@@ -70,18 +70,16 @@ struct Bench {
 
 impl Bench {
     fn show(&mut self, volume: Arc<Volume>, appearance: Appearance, view: VolumeView) -> Result<(f64, image::RgbaImage), String> {
-        self.show_with(volume, appearance, view, false)
+        self.place(volume, appearance);
+        self.off.set_view(view);
+        let image = self.off.capture()?;
+        let t = self.off.time_frames(self.frames);
+        Ok((t.as_secs_f64() * 1000.0, image))
     }
 
-    /// [`Self::show`]; with `orbit`, the camera turns half a degree about the volume
-    /// every timed frame (so what depends on the camera is recomputed each frame).
-    fn show_with(
-        &mut self,
-        volume: Arc<Volume>,
-        appearance: Appearance,
-        view: VolumeView,
-        orbit: bool,
-    ) -> Result<(f64, image::RgbaImage), String> {
+    /// Shows `volume` alone, framed from the oblique view; the camera and the volume's
+    /// centre.
+    fn place(&mut self, volume: Arc<Volume>, appearance: Appearance) -> (focal::region::Camera, Vec3) {
         let world = self.off.world_mut();
         let old: Vec<Entity> = world.query_filtered::<Entity, With<Dataset>>().iter(world).collect();
         for e in old {
@@ -91,20 +89,79 @@ impl Bench {
         self.off.world_mut().spawn((Dataset::new(volume, appearance), Transform::default()));
         let camera = View::Oblique.frame_box(lo, hi, self.off.width as f32 / self.off.height as f32, false);
         self.off.set_camera(&camera);
-        self.off.set_view(view);
-        let image = self.off.capture()?;
-        let centre = (lo + hi) * 0.5;
-        let t = self.off.time_frames_with(self.frames, |off, k| {
-            if orbit {
-                let turn = Quat::from_rotation_y((k + 1) as f32 * 0.5f32.to_radians());
-                off.set_camera(&focal::region::Camera {
-                    position: centre + turn * (camera.position - centre),
-                    rotation: turn * camera.rotation,
-                    ..camera
+        (camera, (lo + hi) * 0.5)
+    }
+}
+
+/// A configuration of the lens group: name, lenses, view switches.
+type LensConfig = (&'static str, Vec<Lens>, VolumeView);
+
+impl Bench {
+    /// Shows `volume`, then times every configuration in rounds of one frame each and
+    /// takes each configuration's median: drift of the machine (other load, clock
+    /// changes) then hits all of them alike, which timing them one after another does
+    /// not. With `orbit`, the camera turns half a degree about the volume before every
+    /// frame (so what depends on the camera is recomputed each frame).
+    fn interleaved(
+        &mut self,
+        volume: Arc<Volume>,
+        appearance: Appearance,
+        configs: &[LensConfig],
+        orbit: bool,
+    ) -> Result<Vec<f64>, String> {
+        let (camera, centre) = self.place(volume, appearance);
+        let mut turn = 0u32;
+        let set = |off: &mut Offscreen, (_, lenses, view): &LensConfig| {
+            replace_lenses(off.world_mut(), lenses);
+            off.set_view(*view);
+        };
+        // Every configuration once first (pipelines, atlases).
+        for config in configs {
+            set(&mut self.off, config);
+            self.off.capture()?;
+        }
+        let mut times = vec![Vec::new(); configs.len()];
+        for _ in 0..self.frames {
+            for (config, samples) in configs.iter().zip(&mut times) {
+                set(&mut self.off, config);
+                // (An untimed frame first takes the switch.)
+                let t = self.off.time_frames_with(1, |off, _| {
+                    if orbit {
+                        turn += 1;
+                        let q = Quat::from_rotation_y(turn as f32 * 0.5f32.to_radians());
+                        off.set_camera(&focal::region::Camera {
+                            position: centre + q * (camera.position - centre),
+                            rotation: q * camera.rotation,
+                            ..camera
+                        });
+                    }
                 });
+                samples.push(t.as_secs_f64() * 1000.0);
             }
+        }
+        Ok(times
+            .into_iter()
+            .map(|mut v| {
+                v.sort_by(f64::total_cmp);
+                v[v.len() / 2]
+            })
+            .collect())
+    }
+}
+
+/// Rows of a group timed by [`Bench::interleaved`], against its first configuration.
+fn push_group(rows: &mut Vec<Row>, configs: &[LensConfig], ms: &[f64], base_note: &str, note: &str) {
+    let base = configs[0].0.to_string();
+    for (i, ((name, _, _), t)) in configs.iter().zip(ms).enumerate() {
+        let note = if i == 0 { base_note } else { note };
+        rows.push(Row {
+            group: "lenses",
+            config: name.to_string(),
+            ms: *t,
+            baseline: base.clone(),
+            ratio: t / ms[0].max(1e-9),
+            note: note.into(),
         });
-        Ok((t.as_secs_f64() * 1000.0, image))
     }
 }
 
@@ -200,17 +257,10 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
     if all || args.lenses {
         let ct = Arc::new(Phantom::Head.generate(args.resolution)?);
         let a = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone")?);
-        let (plain, _) = bench.show(ct.clone(), a.clone(), still)?;
-        let base = "no lens".to_string();
-        rows.push(Row {
-            group: "lenses",
-            config: base.clone(),
-            ms: plain,
-            baseline: base.clone(),
-            ratio: 1.0,
-            note: "head phantom, CT skin + bone".into(),
-        });
         let magnifier = Lens::magnifier(Vec2::new(0.1, 0.05), 0.3, 0.15, 2.5);
+        // A magnifier of factor 1 bends no ray: the cost of the lens code alone, with
+        // the picture unchanged (a real lens also changes what the rays cross).
+        let null = Lens::magnifier(Vec2::new(0.1, 0.05), 0.3, 0.15, 1.0);
         let sampling =
             Lens { kind: LensKind::Sampling(Sampling::Cubic { center_rate: 3.0 }), ..Lens::magnifier(Vec2::ZERO, 0.5, 0.0, 1.0) };
         let fisheye =
@@ -221,68 +271,34 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             Lens { center: Vec2::new(-0.5, -0.4), radius: 0.3, ..sampling.clone() },
             Lens { center: Vec2::new(0.5, -0.4), radius: 0.3, ..fisheye.clone() },
         ];
-        // A magnifier of factor 1 bends no ray: the cost of the lens code alone, with
-        // the picture unchanged (a real lens also changes what the rays cross).
-        let null = Lens::magnifier(Vec2::new(0.1, 0.05), 0.3, 0.15, 1.0);
-        let configs: Vec<(&str, Vec<Lens>, bool)> = vec![
-            ("lens code (×1)", vec![null.clone()], false),
-            ("lens code + AA", vec![null], true),
-            ("magnifier", vec![magnifier.clone()], false),
-            ("magnifier + AA", vec![magnifier], true),
-            ("sampling + AA", vec![sampling], true),
-            ("angular + AA", vec![fisheye], true),
-            ("4 lenses + AA", four, true),
+        let aa = |on: bool| VolumeView { lens_antialias: on, ..still };
+        let configs = [
+            ("no lens", vec![], still),
+            ("lens code (×1)", vec![null.clone()], aa(false)),
+            ("lens code + AA", vec![null], aa(true)),
+            ("magnifier", vec![magnifier.clone()], aa(false)),
+            ("magnifier + AA", vec![magnifier], aa(true)),
+            ("sampling + AA", vec![sampling], aa(true)),
+            ("angular + AA", vec![fisheye], aa(true)),
+            ("4 lenses + AA", four, aa(true)),
         ];
-        for (name, lenses, antialias) in configs {
-            replace_lenses(bench.off.world_mut(), &lenses);
-            let (ms, _) = bench.show(ct.clone(), a.clone(), VolumeView { lens_antialias: antialias, ..still })?;
-            rows.push(Row {
-                group: "lenses",
-                config: name.into(),
-                ms,
-                baseline: base.clone(),
-                ratio: ms / plain.max(1e-9),
-                note: "goal ≤ ×1.10".into(),
-            });
-        }
-        replace_lenses(bench.off.world_mut(), &[]);
+        let ms = bench.interleaved(ct, a, &configs, false)?;
+        push_group(&mut rows, &configs, &ms, "head phantom, CT skin + bone", "goal ≤ ×1.10");
 
         // The feature lens needs its silhouette again whenever the camera moves: timed
         // while orbiting, silhouettes on the GPU (compute passes) and on the CPU.
         let head = phantom::head::generate(args.resolution)?;
-        let labels = Appearance {
-            lookup: Lookup::Labels(LabelTransfer::from_table(
-                &head.labels.table,
-                head.labels.present_ids().into_iter().map(|(id, _)| id),
-                0.4,
-            )),
-            ..Appearance::new(Mode::Dvr, presets::builtin("grayscale_ramp")?)
-        };
-        let volume = Arc::new(head.labels.volume.clone());
-        let (orbit, _) = bench.show_with(volume.clone(), labels.clone(), still, true)?;
-        let base = "no lens, orbiting".to_string();
-        rows.push(Row {
-            group: "lenses",
-            config: base.clone(),
-            ms: orbit,
-            baseline: base.clone(),
-            ratio: 1.0,
-            note: "head phantom labels".into(),
-        });
+        let styles = LabelTransfer::from_table(&head.labels.table, head.labels.present_ids().into_iter().map(|(id, _)| id), 0.4);
+        let labels = Appearance { lookup: Lookup::Labels(styles), ..Appearance::new(Mode::Dvr, presets::builtin("grayscale_ramp")?) };
         let ventricles = focal::lens::feature::FeatureRef { label: phantom::head::label::VENTRICLES as u32, region: None };
         let feature = Lens { shape: focal::lens::Shape::Feature(ventricles), ..Lens::magnifier(Vec2::ZERO, 0.3, 0.15, 2.5) };
-        replace_lenses(bench.off.world_mut(), &[feature]);
-        for (name, gpu) in [("feature (GPU)", true), ("feature (CPU)", false)] {
-            let (ms, _) = bench.show_with(volume.clone(), labels.clone(), VolumeView { gpu_silhouettes: gpu, ..still }, true)?;
-            rows.push(Row {
-                group: "lenses",
-                config: name.into(),
-                ms,
-                baseline: base.clone(),
-                ratio: ms / orbit.max(1e-9),
-                note: "silhouette every frame".into(),
-            });
-        }
+        let configs = [
+            ("no lens, orbiting", vec![], still),
+            ("feature (GPU)", vec![feature.clone()], VolumeView { gpu_silhouettes: true, ..still }),
+            ("feature (CPU)", vec![feature], VolumeView { gpu_silhouettes: false, ..still }),
+        ];
+        let ms = bench.interleaved(Arc::new(head.labels.volume), labels, &configs, true)?;
+        push_group(&mut rows, &configs, &ms, "labelled head phantom", "silhouette every frame; goal ≤ ×1.25");
         replace_lenses(bench.off.world_mut(), &[]);
     }
 
