@@ -93,8 +93,8 @@ impl Bench {
     }
 }
 
-/// A configuration of the lens group: name, lenses, view switches.
-type LensConfig = (&'static str, Vec<Lens>, VolumeView);
+/// A configuration timed by [`Bench::interleaved`]: name, lenses, view switches.
+type Config = (&'static str, Vec<Lens>, VolumeView);
 
 impl Bench {
     /// Shows `volume`, then times every configuration in rounds of one frame each and
@@ -106,19 +106,20 @@ impl Bench {
         &mut self,
         volume: Arc<Volume>,
         appearance: Appearance,
-        configs: &[LensConfig],
+        configs: &[Config],
         orbit: bool,
-    ) -> Result<Vec<f64>, String> {
+    ) -> Result<(Vec<f64>, Vec<image::RgbaImage>), String> {
         let (camera, centre) = self.place(volume, appearance);
         let mut turn = 0u32;
-        let set = |off: &mut Offscreen, (_, lenses, view): &LensConfig| {
+        let set = |off: &mut Offscreen, (_, lenses, view): &Config| {
             replace_lenses(off.world_mut(), lenses);
             off.set_view(*view);
         };
-        // Every configuration once first (pipelines, atlases).
+        // Every configuration once first (pipelines, atlases), and its picture.
+        let mut images = Vec::new();
         for config in configs {
             set(&mut self.off, config);
-            self.off.capture()?;
+            images.push(self.off.capture()?);
         }
         let mut times = vec![Vec::new(); configs.len()];
         for _ in 0..self.frames {
@@ -139,29 +140,23 @@ impl Bench {
                 samples.push(t.as_secs_f64() * 1000.0);
             }
         }
-        Ok(times
+        let medians = times
             .into_iter()
             .map(|mut v| {
                 v.sort_by(f64::total_cmp);
                 v[v.len() / 2]
             })
-            .collect())
+            .collect();
+        Ok((medians, images))
     }
 }
 
 /// Rows of a group timed by [`Bench::interleaved`], against its first configuration.
-fn push_group(rows: &mut Vec<Row>, configs: &[LensConfig], ms: &[f64], base_note: &str, note: &str) {
+fn push_group(rows: &mut Vec<Row>, group: &'static str, configs: &[Config], ms: &[f64], base_note: &str, note: &str) {
     let base = configs[0].0.to_string();
     for (i, ((name, _, _), t)) in configs.iter().zip(ms).enumerate() {
         let note = if i == 0 { base_note } else { note };
-        rows.push(Row {
-            group: "lenses",
-            config: name.to_string(),
-            ms: *t,
-            baseline: base.clone(),
-            ratio: t / ms[0].max(1e-9),
-            note: note.into(),
-        });
+        rows.push(Row { group, config: name.to_string(), ms: *t, baseline: base.clone(), ratio: t / ms[0].max(1e-9), note: note.into() });
     }
 }
 
@@ -193,43 +188,17 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             s.opacity = 0.9;
         }
         let a = Appearance { lookup: Lookup::Labels(styles), ..Appearance::new(Mode::Dvr, presets::builtin("grayscale_ramp")?) };
-        let labels = Arc::new(head.labels.volume);
-        let (on, img_on) = bench.show(labels.clone(), a.clone(), still)?;
-        let (off, img_off) = bench.show(labels, a, VolumeView { skip_empty: false, ..still })?;
-        let base = "skipping on".to_string();
-        rows.push(Row {
-            group: "skipping",
-            config: base.clone(),
-            ms: on,
-            baseline: base.clone(),
-            ratio: 1.0,
-            note: "head phantom arteries (label volume)".into(),
-        });
-        let note = format!("image differs by at most {} levels", difference(&img_on, &img_off));
-        rows.push(Row { group: "skipping", config: "skipping off".into(), ms: off, baseline: base, ratio: off / on, note });
+        let configs = [("skipping on", vec![], still), ("skipping off", vec![], VolumeView { skip_empty: false, ..still })];
+        let (ms, images) = bench.interleaved(Arc::new(head.labels.volume), a, &configs, false)?;
+        let note = format!("image differs by at most {} levels", difference(&images[0], &images[1]));
+        push_group(&mut rows, "skipping", &configs, &ms, "head phantom arteries (label volume)", &note);
     }
     if all || args.termination {
         let ct = Arc::new(Phantom::Head.generate(args.resolution)?);
         let a = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone")?);
-        let (on, _) = bench.show(ct.clone(), a.clone(), still)?;
-        let (off, _) = bench.show(ct, a, VolumeView { early_termination: false, ..still })?;
-        let base = "termination on".to_string();
-        rows.push(Row {
-            group: "termination",
-            config: base.clone(),
-            ms: on,
-            baseline: base.clone(),
-            ratio: 1.0,
-            note: "head phantom, CT skin + bone".into(),
-        });
-        rows.push(Row {
-            group: "termination",
-            config: "termination off".into(),
-            ms: off,
-            baseline: base,
-            ratio: off / on,
-            note: String::new(),
-        });
+        let configs = [("termination on", vec![], still), ("termination off", vec![], VolumeView { early_termination: false, ..still })];
+        let (ms, _) = bench.interleaved(ct, a, &configs, false)?;
+        push_group(&mut rows, "termination", &configs, &ms, "head phantom, CT skin + bone", "");
     }
     if all || args.modes {
         let engine = Arc::new(Phantom::Engine.generate(args.resolution)?);
@@ -282,8 +251,8 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             ("angular + AA", vec![fisheye], aa(true)),
             ("4 lenses + AA", four, aa(true)),
         ];
-        let ms = bench.interleaved(ct, a, &configs, false)?;
-        push_group(&mut rows, &configs, &ms, "head phantom, CT skin + bone", "goal ≤ ×1.10");
+        let (ms, _) = bench.interleaved(ct, a, &configs, false)?;
+        push_group(&mut rows, "lenses", &configs, &ms, "head phantom, CT skin + bone", "goal ≤ ×1.10");
 
         // The feature lens needs its silhouette again whenever the camera moves: timed
         // while orbiting, silhouettes on the GPU (compute passes) and on the CPU.
@@ -297,8 +266,8 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             ("feature (GPU)", vec![feature.clone()], VolumeView { gpu_silhouettes: true, ..still }),
             ("feature (CPU)", vec![feature], VolumeView { gpu_silhouettes: false, ..still }),
         ];
-        let ms = bench.interleaved(Arc::new(head.labels.volume), labels, &configs, true)?;
-        push_group(&mut rows, &configs, &ms, "labelled head phantom", "silhouette every frame; goal ≤ ×1.25");
+        let (ms, _) = bench.interleaved(Arc::new(head.labels.volume), labels, &configs, true)?;
+        push_group(&mut rows, "lenses", &configs, &ms, "labelled head phantom", "silhouette every frame; goal ≤ ×1.25");
         replace_lenses(bench.off.world_mut(), &[]);
     }
 
