@@ -225,18 +225,31 @@ fn ring_statistics(img: &image::RgbaImage, lens: &Lens, from: f32, to: f32) -> (
     (mean, values.iter().map(|v| (v - mean).powi(2)).sum::<f32>() / values.len() as f32)
 }
 
+/// `volume` under `lens`, rendered without and with anti-aliasing.
+fn without_and_with_antialiasing(
+    gpu: &mut Gpu,
+    volume: &Arc<Volume>,
+    appearance: &Appearance,
+    cam: &FocalCamera,
+    lens: &Lens,
+) -> Vec<image::RgbaImage> {
+    set_lenses(gpu, std::slice::from_ref(lens));
+    [false, true]
+        .into_iter()
+        .map(|antialias| {
+            gpu.clear();
+            gpu.off.set_view(VolumeView { jitter: false, lens_antialias: antialias, ..Default::default() });
+            gpu.off.world_mut().spawn((Dataset::new(volume.clone(), appearance.clone()), Transform::default()));
+            gpu.off.set_camera(cam);
+            gpu.off.capture().unwrap_or_else(|e| panic!("{e}"))
+        })
+        .collect()
+}
+
 pub fn antialiasing_removes_moire_where_lenses_compress(gpu: &mut Gpu) {
     let (v, a, cam) = fine_pattern();
     let lens = Lens::magnifier(Vec2::ZERO, 0.3, 0.45, 3.0);
-    set_lenses(gpu, std::slice::from_ref(&lens));
-    let mut images = Vec::new();
-    for antialias in [false, true] {
-        gpu.clear();
-        gpu.off.set_view(VolumeView { jitter: false, lens_antialias: antialias, ..Default::default() });
-        gpu.off.world_mut().spawn((Dataset::new(v.clone(), a.clone()), Transform::default()));
-        gpu.off.set_camera(&cam);
-        images.push(gpu.off.capture().unwrap_or_else(|e| panic!("{e}")));
-    }
+    let images = without_and_with_antialiasing(gpu, &v, &a, &cam, &lens);
     // A simple-profile magnifier jumps from ×3 to ×1 at its rim: nothing is compressed,
     // so anti-aliasing changes nothing (no blurred seam along the rim; one-sided ray
     // differences, `Footprint::over`).
@@ -244,15 +257,7 @@ pub fn antialiasing_removes_moire_where_lenses_compress(gpu: &mut Gpu) {
         kind: LensKind::Magnifier { magnification: 3.0, profile: Profile::Simple, focus_depth: None, plane_depth: None },
         ..lens.clone()
     };
-    set_lenses(gpu, std::slice::from_ref(&simple));
-    let mut rims = Vec::new();
-    for antialias in [false, true] {
-        gpu.clear();
-        gpu.off.set_view(VolumeView { jitter: false, lens_antialias: antialias, ..Default::default() });
-        gpu.off.world_mut().spawn((Dataset::new(v.clone(), a.clone()), Transform::default()));
-        gpu.off.set_camera(&cam);
-        rims.push(gpu.off.capture().unwrap_or_else(|e| panic!("{e}")));
-    }
+    let rims = without_and_with_antialiasing(gpu, &v, &a, &cam, &simple);
     let seam = rims[0].pixels().zip(rims[1].pixels()).filter(|(p, q)| (0..3).any(|k| p[k].abs_diff(q[k]) > 8)).count();
     println!("    simple profile: {seam} pixels changed by anti-aliasing");
     assert!(seam <= 4, "anti-aliasing changed {seam} pixels where nothing is compressed (a seam at the rim)");
