@@ -7,6 +7,9 @@
 // the reference: hardware trilinear weights, the scene depth that ends every ray at
 // the first mesh, and jumps over empty bricks (landing on the same sample grid).
 //
+// Every loop along the ray is bounded by scene.max_steps, a number from the uniforms
+// (render::pack::march_bound explains why llvmpipe needs it).
+//
 // Shader defs select the code a scene needs (software rasterisers execute every branch
 // of divergent code, so unused modes cost time even when no pixel takes them):
 // HAS_DVR (DVR, gradient-modulated DVR, labels), HAS_GRADIENT_MODULATION, HAS_LABELS,
@@ -177,7 +180,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
     // 2.–4. Walk the segments.
     var acc = vec4(0.0);
     var k = 0.0;
-    loop {
+    for (var march_steps = 0u; march_steps < scene.max_steps; march_steps++) {
         let t = t_start + (k + j) * step;
         if t > t_last || acc.a >= stop {
             break;
@@ -229,7 +232,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                 var mn = vmin[s];
                 var sum = vsum[s];
                 var c = count[s];
-                loop {
+                for (var projection_steps = 0u; projection_steps < scene.max_steps; projection_steps++) {
                     if kk > k_end {
                         break;
                     }
@@ -265,7 +268,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                 var has = (state[s] & HAS_PREV) != 0u;
                 var tp = prev_t[s];
                 var vp = prev_v[s];
-                loop {
+                for (var iso_steps = 0u; iso_steps < scene.max_steps; iso_steps++) {
                     if kk > k_end {
                         break;
                     }
@@ -295,21 +298,38 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #ifdef HAS_DVR
                 // With skipping off this is plain marching: every sample is classified.
                 let occupancy = skip && (r.flags & REGION_OCCUPANCY) != 0u;
-                loop {
+                for (var dvr_steps = 0u; dvr_steps < scene.max_steps; dvr_steps++) {
                     if kk > k_end || acc.a >= stop {
                         break;
+                    }
+                    // Empty bricks are crossed in a loop of their own: the lanes of a
+                    // SIMD group that skip wait for each other there, then all lanes
+                    // take the next (expensive) sample together. Occupancy holds for
+                    // full-resolution samples only (a coarser level blends in
+                    // neighbouring bricks).
+                    if occupancy {
+                        for (var skip_steps = 0u; skip_steps < scene.max_steps; skip_steps++) {
+                            if kk > k_end {
+                                break;
+                            }
+                            let q = q0 + dq * (kk - k);
+#ifdef HAS_LENSES
+                            update_lod(t_start + (kk + j) * step);
+#endif
+                            if !at_full_resolution() || brick_occupied(r, q) {
+                                break;
+                            }
+                            let tk = t_start + (kk + j) * step;
+                            kk = max(kk + 1.0, ceil((brick_exit(r, q, qd, tk) - t_start) / step - j));
+                        }
+                        if kk > k_end {
+                            break;
+                        }
                     }
                     let q = q0 + dq * (kk - k);
 #ifdef HAS_LENSES
                     update_lod(t_start + (kk + j) * step);
 #endif
-                    // Occupancy holds for full-resolution samples only (a coarser level
-                    // blends in neighbouring bricks).
-                    if occupancy && at_full_resolution() && !brick_occupied(r, q) {
-                        let tk = t_start + (kk + j) * step;
-                        kk = max(kk + 1.0, ceil((brick_exit(r, q, qd, tk) - t_start) / step - j));
-                        continue;
-                    }
                     acc = dvr_sample(r, q, ratios[s], ray.dir, acc);
                     kk += 1.0;
                 }

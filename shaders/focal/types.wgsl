@@ -57,7 +57,8 @@ struct SceneInfo {
     inv_atlas_size: vec4<f32>,
     region_count: u32,
     lut_atlas_width: u32,
-    pad_a: u32,
+    // Bound on the iterations of every loop along a ray (render::pack::march_bound).
+    max_steps: u32,
     pad_b: u32,
 }
 

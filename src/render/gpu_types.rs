@@ -164,6 +164,7 @@ pub struct GpuSceneInfo {
     pub region_count: u32,
     /// Width of the LUT atlas in texels.
     pub lut_atlas_width: u32,
-    pub pad_a: u32,
+    /// Bound on the iterations of every loop along a ray ([`super::pack::march_bound`]).
+    pub max_steps: u32,
     pub pad_b: u32,
 }

@@ -2,6 +2,7 @@
 
 use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
+use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::extract_component::{ComponentUniforms, DynamicUniformIndex};
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, ViewQuery};
@@ -69,6 +70,8 @@ pub fn raycast_pass(
             fields.fields.as_entire_binding(),
         )),
     );
+    let diagnostics = ctx.diagnostic_recorder();
+    let diagnostics = diagnostics.as_deref();
     let mut pass = ctx.command_encoder().begin_render_pass(&RenderPassDescriptor {
         label: Some("focal_raycast_pass"),
         color_attachments: &[Some(RenderPassColorAttachment {
@@ -88,8 +91,10 @@ pub fn raycast_pass(
         let (p, s) = (v.physical_position.as_vec2(), v.physical_size.as_vec2());
         pass.set_viewport(p.x, p.y, s.x, s.y, v.depth.start, v.depth.end);
     }
+    let span = diagnostics.pass_span(&mut pass, "focal_raycast");
     pass.set_pipeline(render_pipeline);
     pass.set_bind_group(0, &bind_group, &[view_offset.offset, settings_index.index()]);
     pass.draw(0..3, 0..1);
+    span.end(&mut pass);
     progress.count_draw();
 }

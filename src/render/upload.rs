@@ -225,7 +225,7 @@ fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScen
         inv_atlas_size: inv.extend(0.0),
         region_count: packed.regions.len() as u32,
         lut_atlas_width: LUT_ATLAS_WIDTH,
-        pad_a: 0,
+        max_steps: packed.max_steps,
         pad_b: 0,
     };
     let mut ub = UniformBuffer::new(Vec::new());
