@@ -10,6 +10,8 @@
 //! pixels within 6 levels; a few pixels where a ray grazes a steep edge may differ more.
 
 mod common;
+#[path = "gpu/context.rs"]
+mod context;
 #[path = "gpu/lenses.rs"]
 mod lenses;
 
@@ -87,6 +89,8 @@ fn opaque_ramp() -> TransferFunction {
         units: None,
         color: vec![ColorPoint(0.0, [0.0; 3]), ColorPoint(1.0, [1.0; 3])],
         opacity: vec![OpacityPoint(0.0, 1.0)],
+        lambda_t: vec![],
+        lambda_s: vec![],
     }
 }
 
@@ -318,7 +322,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [(&str, fn(&mut Gpu)); 13] = [
+    let tests: [(&str, fn(&mut Gpu)); 15] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -332,6 +336,8 @@ fn main() {
         ("outside_the_lens_the_image_is_unchanged", lenses::outside_the_lens_the_image_is_unchanged),
         ("antialiasing_removes_moire_where_lenses_compress", lenses::antialiasing_removes_moire_where_lenses_compress),
         ("feature_lens_matches_the_reference", lenses::feature_lens_matches_the_reference),
+        ("context_matches_the_reference", context::context_matches_the_reference),
+        ("kappa_t_zero_is_dvr_on_the_gpu", context::kappa_t_zero_is_dvr_on_the_gpu),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

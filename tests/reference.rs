@@ -42,6 +42,8 @@ fn opaque_ramp() -> TransferFunction {
         units: None,
         color: vec![ColorPoint(0.0, [0.0; 3]), ColorPoint(1.0, [1.0; 3])],
         opacity: vec![OpacityPoint(0.0, 1.0)],
+        lambda_t: vec![],
+        lambda_s: vec![],
     }
 }
 

@@ -17,7 +17,7 @@ struct View {
 const BEVY_FULLSCREEN: &str = "#define_import_path bevy_core_pipeline::fullscreen_vertex_shader
 struct FullscreenVertexOutput { @builtin(position) position: vec4<f32>, @location(0) uv: vec2<f32> }";
 
-const MODULES: [&str; 9] = ["types", "bindings", "camera", "regions", "sampling", "lens", "transfer", "shading", "compositing"];
+const MODULES: [&str; 10] = ["types", "bindings", "camera", "regions", "sampling", "lens", "transfer", "shading", "compositing", "context"];
 
 fn read(rel: &str) -> String {
     std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
@@ -36,8 +36,17 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 8] =
-    ["HAS_DVR", "HAS_GRADIENT_MODULATION", "HAS_LABELS", "HAS_PROJECTION", "HAS_ISO", "HAS_SHADING", "MULTI_REGION", "HAS_LENSES"];
+const DEFS: [&str; 9] = [
+    "HAS_DVR",
+    "HAS_GRADIENT_MODULATION",
+    "HAS_LABELS",
+    "HAS_PROJECTION",
+    "HAS_ISO",
+    "HAS_SHADING",
+    "MULTI_REGION",
+    "HAS_LENSES",
+    "HAS_CONTEXT",
+];
 
 #[test]
 fn every_shader_variant_composes_and_validates() {

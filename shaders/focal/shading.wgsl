@@ -3,10 +3,12 @@
 // Two-sided Blinn-Phong (reference: reference::trace::shade):
 // c·(ka + kd·max(N·L, 0)) + ks·max(N·H, 0)^shininess; no gradient, no shading.
 
-fn shade(c: vec3<f32>, g: vec3<f32>, view_dir: vec3<f32>, light: vec4<f32>, k: vec4<f32>, enabled: bool) -> vec3<f32> {
+// (ka + kd·max(N·L, 0), ks·max(N·H, 0)^shininess) for the gradient g; (1, 0) where g
+// vanishes (reference: trace::blinn_phong).
+fn blinn_phong(g: vec3<f32>, view_dir: vec3<f32>, light: vec4<f32>, k: vec4<f32>) -> vec2<f32> {
     let len = length(g);
-    if !enabled || len < 1e-6 {
-        return c;
+    if len < 1e-6 {
+        return vec2(1.0, 0.0);
     }
     let v = -view_dir;
     var n = g / len;
@@ -23,6 +25,20 @@ fn shade(c: vec3<f32>, g: vec3<f32>, view_dir: vec3<f32>, light: vec4<f32>, k: v
     } else {
         h = v;
     }
-    let lit = c * (k.x + k.y * max(dot(n, l), 0.0)) + vec3(k.z * pow(max(dot(n, h), 0.0), k.w));
-    return clamp(lit, vec3(0.0), vec3(1.0));
+    return vec2(k.x + k.y * max(dot(n, l), 0.0), k.z * pow(max(dot(n, h), 0.0), k.w));
+}
+
+fn shade(c: vec3<f32>, g: vec3<f32>, view_dir: vec3<f32>, light: vec4<f32>, k: vec4<f32>, enabled: bool) -> vec3<f32> {
+    if !enabled || length(g) < 1e-6 {
+        return c;
+    }
+    let terms = blinn_phong(g, view_dir, light, k);
+    return clamp(c * terms.x + vec3(terms.y), vec3(0.0), vec3(1.0));
+}
+
+// s(P) of context-preserving rendering: the Blinn-Phong intensity in [0, 1], 1 where
+// the gradient vanishes (reference: trace::shading_intensity).
+fn shading_intensity(g: vec3<f32>, view_dir: vec3<f32>, light: vec4<f32>, k: vec4<f32>) -> f32 {
+    let terms = blinn_phong(g, view_dir, light, k);
+    return clamp(terms.x + terms.y, 0.0, 1.0);
 }

@@ -7,12 +7,23 @@
 #import focal::types::Region
 #import focal::sampling::lut_texel
 
-fn classify(r: Region, t: f32, atlas_width: u32) -> vec4<f32> {
+// The table of lut_width texels at `base`, linearly filtered at the sample t.
+fn filtered(r: Region, base: u32, t: f32, atlas_width: u32) -> vec4<f32> {
     let n = f32(r.lut_width);
     let x = clamp((r.lut_a * t + r.lut_b) * n - 0.5, 0.0, n - 1.0);
     let i = min(u32(x), r.lut_width - 2u);
     let f = x - f32(i);
-    return mix(lut_texel(r.lut_offset + i, atlas_width), lut_texel(r.lut_offset + i + 1u, atlas_width), f);
+    return mix(lut_texel(base + i, atlas_width), lut_texel(base + i + 1u, atlas_width), f);
+}
+
+fn classify(r: Region, t: f32, atlas_width: u32) -> vec4<f32> {
+    return filtered(r, r.lut_offset, t, atlas_width);
+}
+
+// (λt, λs) of context-preserving regions: the lut_width texels after the colours
+// (reference: Lut::sample_lambda).
+fn classify_lambda(r: Region, t: f32, atlas_width: u32) -> vec2<f32> {
+    return filtered(r, r.lut_offset + r.lut_width, t, atlas_width).xy;
 }
 
 fn classify_label(r: Region, code: u32, atlas_width: u32) -> vec4<f32> {

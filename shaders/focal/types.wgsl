@@ -29,6 +29,10 @@ struct Region {
     pad_c: f32,
     // Atlas offsets of mip levels 1, 2, 3 (xyz).
     mips: array<vec4<f32>, 3>,
+    // Context-preserving κt, κs, power (CONTEXT_SCHLICK or CONTEXT_EXACT).
+    context: vec4<f32>,
+    // World bounding sphere of the volume's box (centre, radius).
+    sphere: vec4<f32>,
 }
 
 struct Lens {
@@ -68,6 +72,10 @@ const MODE_MIN_IP: u32 = 2u;
 const MODE_X_RAY: u32 = 3u;
 const MODE_GRADIENT_DVR: u32 = 4u;
 const MODE_ISO: u32 = 5u;
+const MODE_CONTEXT: u32 = 6u;
+
+const CONTEXT_SCHLICK: f32 = 0.0;
+const CONTEXT_EXACT: f32 = 1.0;
 
 const REGION_LABELS: u32 = 1u;
 const REGION_SHADING: u32 = 2u;

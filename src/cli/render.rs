@@ -1,6 +1,7 @@
 //! `focal render`: scene files, or one data file with options, to PNG (GPU by default,
 //! `--cpu` for the reference renderer).
 
+use focal::context::ContextParams;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
@@ -74,6 +75,12 @@ pub struct RenderArgs {
     /// Resolution of generated phantoms.
     #[arg(long, default_value_t = 256)]
     resolution: u32,
+    /// κt of the context-preserving mode (`--mode context`): how deep the view reaches.
+    #[arg(long)]
+    kappa_t: Option<f32>,
+    /// κs of the context-preserving mode: how sharp the transition is.
+    #[arg(long)]
+    kappa_s: Option<f32>,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -133,6 +140,10 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
         shading,
         step: args.step,
         iso: args.iso,
+        context: {
+            let d = ContextParams::default();
+            ContextParams { kappa_t: args.kappa_t.unwrap_or(d.kappa_t), kappa_s: args.kappa_s.unwrap_or(d.kappa_s), ..d }
+        },
     };
     let camera = match (args.azimuth, args.elevation) {
         (None, None) => CameraSpec::View { view: args.view, orthographic: args.ortho, zoom: args.zoom },

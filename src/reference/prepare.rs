@@ -3,6 +3,7 @@
 
 use glam::{Mat3, Vec3};
 
+use crate::context::ContextParams;
 use crate::region::{Appearance, Lookup, Mode, Region, Shading};
 use crate::transfer::Lut;
 use crate::volume::pyramid::level_index;
@@ -24,6 +25,15 @@ impl PreparedLookup {
         match self {
             PreparedLookup::Transfer { lut, a, b } => lut.sample(a * t + b),
             PreparedLookup::Labels(table) => table.get(code as usize).copied().unwrap_or([0.0; 4]),
+        }
+    }
+
+    /// (λt, λs) of a normalised sample (1 for label volumes).
+    #[inline]
+    pub fn lambda(&self, t: f32) -> [f32; 2] {
+        match self {
+            PreparedLookup::Transfer { lut, a, b } => lut.sample_lambda(a * t + b),
+            PreparedLookup::Labels(_) => [1.0, 1.0],
         }
     }
 }
@@ -51,6 +61,11 @@ pub struct PreparedRegion<'a> {
     /// Per-brick visibility (DVR modes with a transfer function): invisible bricks add
     /// nothing and are not sampled.
     pub occupancy: Option<(&'a BrickGrid, Vec<bool>)>,
+    /// κt, κs of [`Mode::Context`].
+    pub context: ContextParams,
+    /// World-space bounding sphere (centre, radius) of the volume's box: the extent the
+    /// context-preserving eye distance is normalised over.
+    pub sphere: (Vec3, f32),
 }
 
 impl<'a> PreparedRegion<'a> {
@@ -84,6 +99,8 @@ impl<'a> PreparedRegion<'a> {
             iso: volume.real_to_normalized(appearance.iso_value) as f32,
             gradient_max: volume.gradient_max().max(1e-6),
             occupancy,
+            context: appearance.context,
+            sphere: bounding_sphere(region, volume),
         }
     }
 
@@ -148,4 +165,17 @@ impl<'a> PreparedRegion<'a> {
             PreparedLookup::Transfer { .. } => self.sampler.gradient(q),
         }
     }
+}
+
+/// World-space bounding sphere of the volume's box as the region places it (voxel
+/// centres span `-0.5 … dims − 0.5` in index space).
+pub fn bounding_sphere(region: &Region, volume: &Volume) -> (Vec3, f32) {
+    let to_world = region.world_to_voxel.inverse();
+    let dims = volume.dims().as_vec3();
+    let lo = Vec3::splat(-0.5);
+    let corners =
+        (0..8).map(|i| to_world.transform_point3(lo + dims * Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32)));
+    let centre = to_world.transform_point3(lo + dims * 0.5);
+    let radius = corners.map(|c| c.distance(centre)).fold(0.0f32, f32::max);
+    (centre, radius)
 }

@@ -11,6 +11,8 @@
 //!      `α = 1 − (1 − α_TF)^(Δ_native/Δ₀)`, colour Blinn-Phong shaded with the gradient
 //!      normal, composited front to back `C += (1 − A)·α·c`, `A += (1 − A)·α`;
 //!    - gradient-modulated DVR: as DVR with `α ·= |∇f| / max|∇f|`;
+//!    - context-preserving DVR: as DVR with α from equation 5 of Bruckner et al.
+//!      ([`crate::context::model`]; the accumulated opacity in front is `A`);
 //!    - MIP / MinIP / X-ray: the region keeps the max / min / mean of its samples and
 //!      emits `TF(value)` as one sample when the ray leaves its interval;
 //!    - iso-surface: the first sign change of `f − iso` between samples is refined by
@@ -22,6 +24,7 @@
 use glam::{Vec3, Vec4};
 
 use super::prepare::PreparedRegion;
+use crate::context::model as context;
 use crate::lens::antialias::Footprint;
 use crate::region::{Light, Mode, Ray, Shading};
 use crate::transfer::opacity;
@@ -154,7 +157,7 @@ pub fn trace_antialiased(
                     st.sum += v;
                     st.count += 1;
                 }
-                Mode::Dvr | Mode::GradientDvr => {
+                Mode::Dvr | Mode::GradientDvr | Mode::Context => {
                     // Occupancy holds for full-resolution samples only.
                     if level <= 0.0 && !r.occupied(q) {
                         continue;
@@ -166,10 +169,22 @@ pub fn trace_antialiased(
                     }
                     let mut alpha = opacity::correct(rgba[3], st.ratio);
                     let g = r.index_gradient_at(q, level);
+                    let gradient = (g.length() / r.gradient_max).min(1.0);
+                    let world_g = r.normal_matrix * g;
                     if r.mode == Mode::GradientDvr {
-                        alpha *= (g.length() / r.gradient_max).min(1.0);
+                        alpha *= gradient;
+                    } else if r.mode == Mode::Context {
+                        let sample = context::Sample {
+                            alpha,
+                            gradient,
+                            shading: shading_intensity(world_g, view, light, &r.shading),
+                            eye_distance: context::eye_distance(t, ray.origin, ray.dir, r.sphere.0, r.sphere.1),
+                            alpha_prev: out.color.w,
+                            lambda: r.lookup.lambda(v),
+                        };
+                        alpha = context::opacity(&r.context, &sample);
                     }
-                    let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), r.normal_matrix * g, view, light, &r.shading);
+                    let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), world_g, view, light, &r.shading);
                     composite(&mut out, c, alpha, t, i, depth_threshold);
                 }
                 Mode::Iso => {
@@ -254,9 +269,21 @@ fn refine(r: &PreparedRegion, ray: &Ray, (mut ta, va): (f32, f32), (mut tb, _): 
 /// along the ray direction `view`. Two-sided: the normal is turned towards the viewer.
 /// A vanishing gradient (no surface) leaves the colour unshaded.
 pub fn shade(c: Vec3, g: Vec3, view: Vec3, light: Light, s: &Shading) -> Vec3 {
-    let len = g.length();
-    if !s.enabled || len < 1e-6 {
+    if !s.enabled {
         return c;
+    }
+    match blinn_phong(g, view, light, s) {
+        Some((diffuse, specular)) => (c * diffuse + Vec3::splat(specular)).clamp(Vec3::ZERO, Vec3::ONE),
+        None => c,
+    }
+}
+
+/// The two terms of Blinn-Phong: `(ka + kd·max(N·L, 0), ks·max(N·H, 0)^shininess)`,
+/// `None` where the gradient vanishes.
+pub fn blinn_phong(g: Vec3, view: Vec3, light: Light, s: &Shading) -> Option<(f32, f32)> {
+    let len = g.length();
+    if len < 1e-6 {
+        return None;
     }
     let v = -view;
     let mut n = g / len;
@@ -268,8 +295,13 @@ pub fn shade(c: Vec3, g: Vec3, view: Vec3, light: Light, s: &Shading) -> Vec3 {
         Light::Direction(d) => d.normalize_or(v),
     };
     let h = (l + v).normalize_or(v);
-    let lit = c * (s.ambient + s.diffuse * n.dot(l).max(0.0)) + Vec3::splat(s.specular * n.dot(h).max(0.0).powf(s.shininess));
-    lit.clamp(Vec3::ZERO, Vec3::ONE)
+    Some((s.ambient + s.diffuse * n.dot(l).max(0.0), s.specular * n.dot(h).max(0.0).powf(s.shininess)))
+}
+
+/// s(P) of context-preserving rendering (equation 3): the Blinn-Phong intensity
+/// clamped to [0, 1], whether or not colours are shaded; 1 where the gradient vanishes.
+pub fn shading_intensity(g: Vec3, view: Vec3, light: Light, s: &Shading) -> f32 {
+    blinn_phong(g, view, light, s).map_or(1.0, |(d, sp)| (d + sp).clamp(0.0, 1.0))
 }
 
 /// Deterministic per-pixel jitter in `[0, 1)` (the same integer hash as the shader).

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use glam::Vec3;
 
+use crate::context::ContextParams;
 use crate::transfer::{LabelTransfer, Lut, TransferFunction};
 use crate::volume::Volume;
 
@@ -27,10 +28,13 @@ pub enum Mode {
     GradientDvr,
     /// First hit of an iso-value, shaded.
     Iso,
+    /// Context-preserving DVR (Bruckner et al. 2005, [`crate::context`]): opacity
+    /// modulated by gradient magnitude, shading, eye distance and accumulated opacity.
+    Context,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 6] = [Mode::Dvr, Mode::Mip, Mode::MinIp, Mode::XRay, Mode::GradientDvr, Mode::Iso];
+    pub const ALL: [Mode; 7] = [Mode::Dvr, Mode::Mip, Mode::MinIp, Mode::XRay, Mode::GradientDvr, Mode::Iso, Mode::Context];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -40,6 +44,7 @@ impl Mode {
             Mode::XRay => "xray",
             Mode::GradientDvr => "gradient_dvr",
             Mode::Iso => "iso",
+            Mode::Context => "context",
         }
     }
 
@@ -56,7 +61,7 @@ impl std::str::FromStr for Mode {
         Mode::ALL
             .into_iter()
             .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown mode '{s}' (dvr, mip, minip, xray, gradient_dvr, iso)"))
+            .ok_or_else(|| format!("unknown mode '{s}' (dvr, mip, minip, xray, gradient_dvr, iso, context)"))
     }
 }
 
@@ -105,11 +110,20 @@ pub struct Appearance {
     pub step: f32,
     /// Iso-value in real units (for [`Mode::Iso`]).
     pub iso_value: f64,
+    /// κt, κs of [`Mode::Context`].
+    pub context: ContextParams,
 }
 
 impl Appearance {
     pub fn new(mode: Mode, tf: TransferFunction) -> Self {
-        Self { mode, lookup: Lookup::Transfer(tf), shading: Shading::default(), step: 0.5, iso_value: 0.0 }
+        Self {
+            mode,
+            lookup: Lookup::Transfer(tf),
+            shading: Shading::default(),
+            step: 0.5,
+            iso_value: 0.0,
+            context: ContextParams::default(),
+        }
     }
 
     /// Which bricks of `volume` can contribute under this appearance, for the modes that
@@ -119,7 +133,7 @@ impl Appearance {
     pub fn brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {
         let bricks = volume.bricks();
         match &self.lookup {
-            Lookup::Transfer(tf) if matches!(self.mode, Mode::Dvr | Mode::GradientDvr) => {
+            Lookup::Transfer(tf) if matches!(self.mode, Mode::Dvr | Mode::GradientDvr | Mode::Context) => {
                 let lut = Lut::for_volume(tf, volume);
                 let map = &volume.values;
                 Some(bricks.occupancy(|lo, hi| lut.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0))

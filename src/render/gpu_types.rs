@@ -15,6 +15,13 @@ pub mod mode {
     pub const X_RAY: u32 = 3;
     pub const GRADIENT_DVR: u32 = 4;
     pub const ISO: u32 = 5;
+    pub const CONTEXT: u32 = 6;
+}
+
+/// How a region evaluates the outer power of context-preserving opacity.
+pub mod context_power {
+    pub const SCHLICK: f32 = 0.0;
+    pub const EXACT: f32 = 1.0;
 }
 
 /// Region flags.
@@ -38,9 +45,11 @@ pub mod features {
     pub const MULTI_REGION: u32 = 64;
     /// The view has lenses (a per-view feature).
     pub const LENSES: u32 = 128;
+    /// Context-preserving DVR.
+    pub const CONTEXT: u32 = 256;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 8] = [
+    pub const NAMES: [(u32, &str); 9] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -49,6 +58,7 @@ pub mod features {
         (SHADING, "HAS_SHADING"),
         (MULTI_REGION, "MULTI_REGION"),
         (LENSES, "HAS_LENSES"),
+        (CONTEXT, "HAS_CONTEXT"),
     ];
 }
 
@@ -100,6 +110,10 @@ pub struct GpuRegion {
     pub pad_c: f32,
     /// Atlas texel offsets of mip levels 1… (xyz).
     pub mips: [Vec4; MIP_LEVELS],
+    /// Context-preserving κt, κs, power ([`context_power`]).
+    pub context: Vec4,
+    /// World bounding sphere of the volume's box (centre, radius).
+    pub sphere: Vec4,
 }
 
 /// Lens kinds, shapes (codes shared with `shaders/focal/lens.wgsl`).

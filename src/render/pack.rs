@@ -13,7 +13,8 @@ use glam::{Mat3, Mat4, UVec3, Vec3, Vec4};
 
 use crate::volume::pyramid::{MIP_LEVELS, half_dims};
 
-use super::gpu_types::{GpuRegion, mode, region_flags};
+use super::gpu_types::{GpuRegion, context_power, mode, region_flags};
+use crate::context::Power;
 use crate::reference::prepare::{PreparedLookup, PreparedRegion};
 use crate::region::{Mode, RenderScene};
 
@@ -114,6 +115,7 @@ fn mode_number(m: Mode) -> u32 {
         Mode::XRay => mode::X_RAY,
         Mode::GradientDvr => mode::GRADIENT_DVR,
         Mode::Iso => mode::ISO,
+        Mode::Context => mode::CONTEXT,
     }
 }
 
@@ -212,7 +214,7 @@ pub fn march_bound(regions: &[GpuRegion]) -> u32 {
         chords += diagonal as f64;
         step = step.min(r.native_step as f64 / frobenius.max(1e-12) as f64);
     }
-    if regions.is_empty() || !chords.is_finite() || !(step > 0.0) {
+    if regions.is_empty() || !chords.is_finite() || step.is_nan() || step <= 0.0 {
         return 2;
     }
     let bound = (chords / step).ceil() + 3.0 * regions.len() as f64 + 2.0;
@@ -229,6 +231,7 @@ pub fn scene_features(regions: &[GpuRegion]) -> u32 {
             mode::MIP | mode::MIN_IP | mode::X_RAY if !labels => f::PROJECTION,
             mode::ISO if !labels => f::ISO,
             mode::GRADIENT_DVR if !labels => f::DVR | f::GRADIENT_MODULATION,
+            mode::CONTEXT if !labels => f::DVR | f::CONTEXT,
             _ => f::DVR,
         };
         if labels {
@@ -249,6 +252,10 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
     let (lut_a, lut_b, lut_width, labels) = match &p.lookup {
         PreparedLookup::Transfer { lut, a, b } => {
             out.lut.extend_from_slice(&lut.rgba);
+            // Context-preserving regions read (λt, λs) from the next `lut_width` texels.
+            if p.mode == Mode::Context {
+                out.lut.extend(lut.lambda.iter().map(|l| [l[0], l[1], 0.0, 0.0]));
+            }
             (*a, *b, lut.rgba.len() as u32, false)
         }
         PreparedLookup::Labels(table) => {
@@ -303,6 +310,16 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
         pad_b: 0.0,
         pad_c: 0.0,
         mips: std::array::from_fn(|k| levels.get(k + 1).map_or(Vec4::ZERO, |o| o.as_vec3().extend(1.0))),
+        context: Vec4::new(
+            p.context.kappa_t,
+            p.context.kappa_s,
+            match p.context.power {
+                Power::Schlick => context_power::SCHLICK,
+                Power::Exact => context_power::EXACT,
+            },
+            0.0,
+        ),
+        sphere: p.sphere.0.extend(p.sphere.1),
     }
 }
 

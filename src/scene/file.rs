@@ -24,6 +24,8 @@ use std::path::PathBuf;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use crate::context::ContextParams;
+
 use crate::region::{Light, Mode, Shading, View};
 use crate::transfer::TransferFunction;
 use crate::volume::phantom::Phantom;
@@ -157,11 +159,23 @@ pub struct AppearanceSpec {
     /// Iso-value in the data's units (default: middle of the value range).
     #[serde(default)]
     pub iso: Option<f64>,
+    /// κt, κs of the context-preserving mode.
+    #[serde(default)]
+    pub context: ContextParams,
 }
 
 impl Default for AppearanceSpec {
     fn default() -> Self {
-        Self { mode: Mode::Dvr, preset: None, transfer: None, labels: None, shading: None, step: 0.5, iso: None }
+        Self {
+            mode: Mode::Dvr,
+            preset: None,
+            transfer: None,
+            labels: None,
+            shading: None,
+            step: 0.5,
+            iso: None,
+            context: ContextParams::default(),
+        }
     }
 }
 
@@ -289,6 +303,11 @@ pub enum Change {
     Shading {
         dataset: usize,
         enabled: bool,
+    },
+    /// The context-preserving parameters.
+    Context {
+        dataset: usize,
+        context: ContextParams,
     },
     Visible {
         dataset: usize,

@@ -139,6 +139,7 @@ pub fn appearance(spec: &AppearanceSpec, volume: &Volume, table: Option<&LabelTa
         shading: spec.shading.unwrap_or_default(),
         step: spec.step,
         iso_value: spec.iso.unwrap_or((volume.stats.min + volume.stats.max) * 0.5),
+        context: spec.context.validated()?,
     })
 }
 
@@ -216,6 +217,7 @@ pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneF
         Change::Step { dataset, step } => datasets[get(*dataset)?].appearance.step = *step,
         Change::Iso { dataset, value } => datasets[get(*dataset)?].appearance.iso_value = *value,
         Change::Shading { dataset, enabled } => datasets[get(*dataset)?].appearance.shading.enabled = *enabled,
+        Change::Context { dataset, context } => datasets[get(*dataset)?].appearance.context = context.validated()?,
         Change::Visible { dataset, visible } => datasets[get(*dataset)?].visible = *visible,
         Change::LabelOpacity { dataset, label, opacity } => match &mut datasets[get(*dataset)?].appearance.lookup {
             Lookup::Labels(styles) => {

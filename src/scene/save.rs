@@ -42,7 +42,16 @@ pub fn appearance_spec(a: &Appearance, labels_table: Option<&LabelsSpec>) -> App
             (None, Some(LabelsSpec { styles, ..base }))
         }
     };
-    AppearanceSpec { mode: a.mode, preset: None, transfer, labels, shading: Some(a.shading), step: a.step, iso: Some(a.iso_value) }
+    AppearanceSpec {
+        mode: a.mode,
+        preset: None,
+        transfer,
+        labels,
+        shading: Some(a.shading),
+        step: a.step,
+        iso: Some(a.iso_value),
+        context: a.context,
+    }
 }
 
 /// Source paths made absolute (the saved file may live elsewhere).

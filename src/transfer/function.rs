@@ -37,6 +37,13 @@ pub struct TransferFunction {
     pub units: Option<String>,
     pub color: Vec<ColorPoint>,
     pub opacity: Vec<OpacityPoint>,
+    /// λt of context-preserving rendering (section 5 of Bruckner et al. 2005), in 0..1
+    /// per value: multiplies κt; 0 makes the value range impenetrable. None: 1 everywhere.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lambda_t: Vec<OpacityPoint>,
+    /// λs: multiplies κs; 0 reduces the value range to gradient-magnitude modulation.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lambda_s: Vec<OpacityPoint>,
 }
 
 impl TransferFunction {
@@ -50,13 +57,17 @@ impl TransferFunction {
                 return Err(format!("'{}': colour point at {v} has a component outside 0..1", self.name));
             }
         }
-        for OpacityPoint(v, a) in &self.opacity {
-            if !v.is_finite() || !a.is_finite() || !(0.0..=1.0).contains(a) {
-                return Err(format!("'{}': opacity point at {v} is {a}, outside 0..1", self.name));
+        for (channel, points) in [("opacity", &self.opacity), ("lambda_t", &self.lambda_t), ("lambda_s", &self.lambda_s)] {
+            for OpacityPoint(v, a) in points {
+                if !v.is_finite() || !a.is_finite() || !(0.0..=1.0).contains(a) {
+                    return Err(format!("'{}': {channel} point at {v} is {a}, outside 0..1", self.name));
+                }
             }
         }
         self.color.sort_by(|a, b| a.0.total_cmp(&b.0));
-        self.opacity.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for points in [&mut self.opacity, &mut self.lambda_t, &mut self.lambda_s] {
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
         Ok(self)
     }
 
@@ -73,6 +84,8 @@ impl TransferFunction {
                     units: None,
                     color: self.color.iter().map(|&ColorPoint(v, c)| ColorPoint(to(v), c)).collect(),
                     opacity: self.opacity.iter().map(|&OpacityPoint(v, a)| OpacityPoint(to(v), a)).collect(),
+                    lambda_t: self.lambda_t.iter().map(|&OpacityPoint(v, a)| OpacityPoint(to(v), a)).collect(),
+                    lambda_s: self.lambda_s.iter().map(|&OpacityPoint(v, a)| OpacityPoint(to(v), a)).collect(),
                 }
             }
         }
@@ -86,8 +99,12 @@ impl TransferFunction {
 
     /// Opacity at a value (points must be absolute and sorted).
     pub fn opacity_at(&self, value: f64) -> f32 {
-        let pts: Vec<(f64, f32)> = self.opacity.iter().map(|p| (p.0, p.1)).collect();
-        piecewise(&pts, value, |a, b, t| a + (b - a) * t)
+        scalar_at(&self.opacity, value, 0.0)
+    }
+
+    /// (λt, λs) at a value, 1 where a channel has no points.
+    pub fn lambda_at(&self, value: f64) -> [f32; 2] {
+        [scalar_at(&self.lambda_t, value, 1.0), scalar_at(&self.lambda_s, value, 1.0)]
     }
 
     /// Smallest and largest value with non-zero opacity, if any.
@@ -105,6 +122,15 @@ impl TransferFunction {
         }
         lo.zip(hi)
     }
+}
+
+/// A scalar channel at a value; `empty` when it has no points.
+fn scalar_at(points: &[OpacityPoint], value: f64, empty: f32) -> f32 {
+    if points.is_empty() {
+        return empty;
+    }
+    let pts: Vec<(f64, f32)> = points.iter().map(|p| (p.0, p.1)).collect();
+    piecewise(&pts, value, |a, b, t| a + (b - a) * t)
 }
 
 /// Piecewise-linear interpolation over sorted `(x, y)` points, constant outside.
@@ -133,6 +159,8 @@ mod tests {
             space: ValueSpace::Absolute,
             units: None,
             color: vec![ColorPoint(100.0, [1.0, 0.0, 0.0]), ColorPoint(0.0, [0.0, 0.0, 1.0])],
+            lambda_t: vec![],
+            lambda_s: vec![],
             opacity: vec![OpacityPoint(0.0, 0.0), OpacityPoint(100.0, 0.5), OpacityPoint(200.0, 0.0)],
         }
         .validated()

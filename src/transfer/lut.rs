@@ -20,6 +20,8 @@ pub const LUT_SIZE_16: usize = 4096;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Lut {
     pub rgba: Vec<[f32; 4]>,
+    /// (λt, λs) of context-preserving rendering at the same texels.
+    pub lambda: Vec<[f32; 2]>,
     /// Real values at the start of the first texel and the end of the last.
     pub lo: f64,
     pub hi: f64,
@@ -30,14 +32,15 @@ impl Lut {
     pub fn bake(tf: &TransferFunction, lo: f64, hi: f64, n: usize) -> Lut {
         let n = n.max(2);
         let hi = if hi > lo { hi } else { lo + 1.0 };
+        let centre = |i: usize| lo + (i as f64 + 0.5) / n as f64 * (hi - lo);
         let rgba = (0..n)
             .map(|i| {
-                let v = lo + (i as f64 + 0.5) / n as f64 * (hi - lo);
-                let c = srgb3_to_linear(tf.color_at(v));
-                [c[0], c[1], c[2], tf.opacity_at(v)]
+                let c = srgb3_to_linear(tf.color_at(centre(i)));
+                [c[0], c[1], c[2], tf.opacity_at(centre(i))]
             })
             .collect();
-        Lut { rgba, lo, hi }
+        let lambda = (0..n).map(|i| tf.lambda_at(centre(i))).collect();
+        Lut { rgba, lambda, lo, hi }
     }
 
     /// Bakes `tf` for a volume: relative points resolved to its range, one texel per code
@@ -83,12 +86,13 @@ impl Lut {
     /// Linearly filtered lookup at texture coordinate `u` (clamp to edge).
     #[inline]
     pub fn sample(&self, u: f32) -> [f32; 4] {
-        let n = self.rgba.len();
-        let x = (u * n as f32 - 0.5).clamp(0.0, (n - 1) as f32);
-        let i = (x as usize).min(n - 2);
-        let t = x - i as f32;
-        let (a, b) = (self.rgba[i], self.rgba[i + 1]);
-        std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t)
+        filtered(&self.rgba, u)
+    }
+
+    /// (λt, λs) at texture coordinate `u`, filtered like [`Self::sample`].
+    #[inline]
+    pub fn sample_lambda(&self, u: f32) -> [f32; 2] {
+        filtered(&self.lambda, u)
     }
 
     /// Largest opacity of any texel that a sample between the real values `lo..=hi` can
@@ -100,6 +104,17 @@ impl Lut {
         let (i0, i1) = (a.floor() as usize, (b.ceil() as usize).min(n - 1));
         self.rgba[i0..=i1].iter().map(|c| c[3]).fold(0.0, f32::max)
     }
+}
+
+/// Linear filtering of a table at texture coordinate `u`, clamped to the edge texels.
+#[inline]
+fn filtered<const N: usize>(table: &[[f32; N]], u: f32) -> [f32; N] {
+    let n = table.len();
+    let x = (u * n as f32 - 0.5).clamp(0.0, (n - 1) as f32);
+    let i = (x as usize).min(n - 2);
+    let t = x - i as f32;
+    let (a, b) = (table[i], table[i + 1]);
+    std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t)
 }
 
 #[cfg(test)]
@@ -114,6 +129,8 @@ mod tests {
             units: None,
             color: vec![ColorPoint(0.0, [0.0; 3]), ColorPoint(100.0, [1.0; 3])],
             opacity: vec![OpacityPoint(0.0, 0.0), OpacityPoint(100.0, 1.0)],
+            lambda_t: vec![],
+            lambda_s: vec![],
         }
     }
 

@@ -327,6 +327,7 @@ fn mode_name(m: Mode) -> &'static str {
         Mode::XRay => "X-ray",
         Mode::GradientDvr => "gradient-modulated DVR",
         Mode::Iso => "iso-surface",
+        Mode::Context => "context-preserving",
     }
 }
 
