@@ -29,16 +29,15 @@ fn blinn_phong(g: vec3<f32>, view_dir: vec3<f32>, light: vec4<f32>, k: vec4<f32>
 }
 
 fn shade(c: vec3<f32>, g: vec3<f32>, view_dir: vec3<f32>, light: vec4<f32>, k: vec4<f32>, enabled: bool) -> vec3<f32> {
-    if !enabled || length(g) < 1e-6 {
+    if !enabled {
         return c;
     }
-    let terms = blinn_phong(g, view_dir, light, k);
-    return clamp(c * terms.x + vec3(terms.y), vec3(0.0), vec3(1.0));
+    return shade_with(c, blinn_phong(g, view_dir, light, k));
 }
 
-// s(P) of context-preserving rendering: the Blinn-Phong intensity in [0, 1], 1 where
-// the gradient vanishes (reference: trace::shading_intensity).
-fn shading_intensity(g: vec3<f32>, view_dir: vec3<f32>, light: vec4<f32>, k: vec4<f32>) -> f32 {
-    let terms = blinn_phong(g, view_dir, light, k);
-    return clamp(terms.x + terms.y, 0.0, 1.0);
+// The colour c lit by Blinn-Phong terms (unchanged by the (1, 0) of a vanishing
+// gradient). s(P) of context-preserving rendering is clamp(terms.x + terms.y, 0, 1)
+// (reference: trace::shading_intensity).
+fn shade_with(c: vec3<f32>, terms: vec2<f32>) -> vec3<f32> {
+    return clamp(c * terms.x + vec3(terms.y), vec3(0.0), vec3(1.0));
 }

@@ -80,6 +80,8 @@ const CONTEXT_EXACT: f32 = 1.0;
 const REGION_LABELS: u32 = 1u;
 const REGION_SHADING: u32 = 2u;
 const REGION_OCCUPANCY: u32 = 4u;
+// The transfer function has λt, λs channels (after the colours in the LUT atlas).
+const REGION_LAMBDA: u32 = 8u;
 
 const VIEW_JITTER: u32 = 1u;
 const VIEW_SKIP_EMPTY: u32 = 2u;

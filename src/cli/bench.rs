@@ -7,7 +7,9 @@
 //! 1 (the lens code alone, same picture), a magnifier with and without anti-aliasing,
 //! the sampling-rate and angular lenses, four lenses at once; goal: at most 10 %
 //! overhead; then the feature lens on the labelled head while the camera orbits, its
-//! silhouette found each frame on the GPU or on the CPU; goal: at most 25 %). Each line
+//! silhouette found each frame on the GPU or on the CPU; goal: at most 25 %),
+//! `--context` (context-preserving rendering against DVR on the engine: at κt = 0, the
+//! same picture, the cost of evaluating equation 5; goal: at most 5 %). Each line
 //! ends with the ratio against its group's baseline; `--json` prints the same as JSON.
 
 use std::sync::Arc;
@@ -15,6 +17,7 @@ use std::sync::Arc;
 use bevy::prelude::*;
 use clap::Args;
 use focal::FocalPlugins;
+use focal::context::{ContextParams, Power};
 use focal::dataset::Dataset;
 use focal::lens::systems::replace_lenses;
 use focal::lens::{Lens, LensKind, Sampling};
@@ -49,6 +52,9 @@ pub struct BenchArgs {
     /// Only the lenses group.
     #[arg(long)]
     lenses: bool,
+    /// Only the context-preserving group.
+    #[arg(long)]
+    context: bool,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -109,22 +115,53 @@ impl Bench {
         configs: &[Config],
         orbit: bool,
     ) -> Result<(Vec<f64>, Vec<image::RgbaImage>), String> {
-        let (camera, centre) = self.place(volume, appearance);
-        let mut turn = 0u32;
-        let set = |off: &mut Offscreen, (_, lenses, view): &Config| {
+        self.interleaved_by(volume, appearance, configs.len(), orbit, |off, i| {
+            let (_, lenses, view) = &configs[i];
             replace_lenses(off.world_mut(), lenses);
             off.set_view(*view);
-        };
+        })
+    }
+
+    /// [`Self::interleaved`] over the appearances of one dataset (no lenses, `view`).
+    fn interleaved_appearances(
+        &mut self,
+        volume: Arc<Volume>,
+        appearances: &[Appearance],
+        view: VolumeView,
+    ) -> Result<(Vec<f64>, Vec<image::RgbaImage>), String> {
+        let first = appearances.first().ok_or("no appearance to time")?.clone();
+        self.interleaved_by(volume, first, appearances.len(), false, |off, i| {
+            off.set_view(view);
+            let world = off.world_mut();
+            let mut q = world.query::<&mut Dataset>();
+            for mut d in q.iter_mut(world) {
+                d.appearance = appearances[i].clone();
+            }
+        })
+    }
+
+    /// The timing loop of [`Self::interleaved`]: `set(off, i)` switches to
+    /// configuration `i` of `count`.
+    fn interleaved_by(
+        &mut self,
+        volume: Arc<Volume>,
+        appearance: Appearance,
+        count: usize,
+        orbit: bool,
+        mut set: impl FnMut(&mut Offscreen, usize),
+    ) -> Result<(Vec<f64>, Vec<image::RgbaImage>), String> {
+        let (camera, centre) = self.place(volume, appearance);
+        let mut turn = 0u32;
         // Every configuration once first (pipelines, atlases), and its picture.
         let mut images = Vec::new();
-        for config in configs {
-            set(&mut self.off, config);
+        for i in 0..count {
+            set(&mut self.off, i);
             images.push(self.off.capture()?);
         }
-        let mut times = vec![Vec::new(); configs.len()];
+        let mut times = vec![Vec::new(); count];
         for _ in 0..self.frames {
-            for (config, samples) in configs.iter().zip(&mut times) {
-                set(&mut self.off, config);
+            for (i, samples) in times.iter_mut().enumerate() {
+                set(&mut self.off, i);
                 // (An untimed frame first takes the switch.)
                 let t = self.off.time_frames_with(1, |off, _| {
                     if orbit {
@@ -151,10 +188,15 @@ impl Bench {
     }
 }
 
+/// Names of configurations.
+fn names(configs: &[Config]) -> Vec<&'static str> {
+    configs.iter().map(|c| c.0).collect()
+}
+
 /// Rows of a group timed by [`Bench::interleaved`], against its first configuration.
-fn push_group(rows: &mut Vec<Row>, group: &'static str, configs: &[Config], ms: &[f64], base_note: &str, note: &str) {
-    let base = configs[0].0.to_string();
-    for (i, ((name, _, _), t)) in configs.iter().zip(ms).enumerate() {
+fn push_group(rows: &mut Vec<Row>, group: &'static str, names: &[&str], ms: &[f64], base_note: &str, note: &str) {
+    let base = names[0].to_string();
+    for (i, (name, t)) in names.iter().zip(ms).enumerate() {
         let note = if i == 0 { base_note } else { note };
         rows.push(Row { group, config: name.to_string(), ms: *t, baseline: base.clone(), ratio: t / ms[0].max(1e-9), note: note.into() });
     }
@@ -171,7 +213,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         .split_once('x')
         .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
         .ok_or_else(|| format!("size '{}' is not WIDTHxHEIGHT", args.size))?;
-    let all = !(args.skipping || args.termination || args.modes || args.lenses);
+    let all = !(args.skipping || args.termination || args.modes || args.lenses || args.context);
     let off = Offscreen::new(w, h, |app| {
         app.add_plugins(FocalPlugins);
     })?;
@@ -191,14 +233,14 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let configs = [("skipping on", vec![], still), ("skipping off", vec![], VolumeView { skip_empty: false, ..still })];
         let (ms, images) = bench.interleaved(Arc::new(head.labels.volume), a, &configs, false)?;
         let note = format!("image differs by at most {} levels", difference(&images[0], &images[1]));
-        push_group(&mut rows, "skipping", &configs, &ms, "head phantom arteries (label volume)", &note);
+        push_group(&mut rows, "skipping", &names(&configs), &ms, "head phantom arteries (label volume)", &note);
     }
     if all || args.termination {
         let ct = Arc::new(Phantom::Head.generate(args.resolution)?);
         let a = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone")?);
         let configs = [("termination on", vec![], still), ("termination off", vec![], VolumeView { early_termination: false, ..still })];
         let (ms, _) = bench.interleaved(ct, a, &configs, false)?;
-        push_group(&mut rows, "termination", &configs, &ms, "head phantom, CT skin + bone", "");
+        push_group(&mut rows, "termination", &names(&configs), &ms, "head phantom, CT skin + bone", "");
     }
     if all || args.modes {
         let engine = Arc::new(Phantom::Engine.generate(args.resolution)?);
@@ -221,6 +263,30 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
                 note: "engine phantom".into(),
             });
         }
+    }
+
+    if all || args.context {
+        // Context-preserving rendering against DVR on the engine (shaded, so DVR fetches
+        // the gradient too). κt = 0 draws the DVR picture while evaluating equation 5 at
+        // every sample: the model's own cost (the paper: 5 % with Schlick's
+        // approximation; goal ≤ ×1.05). At κt = 3 the rays also go deeper (less becomes
+        // opaque early), so those frames do more samples as well.
+        let engine = Arc::new(Phantom::Engine.generate(args.resolution)?);
+        let industrial = presets::builtin("industrial_ct")?;
+        let context = |kappa_t: f32, power: Power| Appearance {
+            context: ContextParams { kappa_t, kappa_s: 0.5, power },
+            ..Appearance::new(Mode::Context, industrial.clone())
+        };
+        let names = ["dvr", "context κt 0", "context κt 3", "context κt 3 exact"];
+        let appearances = [
+            Appearance::new(Mode::Dvr, industrial.clone()),
+            context(0.0, Power::Schlick),
+            context(3.0, Power::Schlick),
+            context(3.0, Power::Exact),
+        ];
+        let (ms, images) = bench.interleaved_appearances(engine, &appearances, still)?;
+        let note = format!("κt 0 differs from DVR by at most {} levels; goal ≤ ×1.05", difference(&images[0], &images[1]));
+        push_group(&mut rows, "context", &names, &ms, "engine phantom", &note);
     }
 
     if all || args.lenses {
@@ -252,7 +318,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             ("4 lenses + AA", four, aa(true)),
         ];
         let (ms, _) = bench.interleaved(ct, a, &configs, false)?;
-        push_group(&mut rows, "lenses", &configs, &ms, "head phantom, CT skin + bone", "goal ≤ ×1.10");
+        push_group(&mut rows, "lenses", &names(&configs), &ms, "head phantom, CT skin + bone", "goal ≤ ×1.10");
 
         // The feature lens needs its silhouette again whenever the camera moves: timed
         // while orbiting, silhouettes on the GPU (compute passes) and on the CPU.
@@ -267,7 +333,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             ("feature (CPU)", vec![feature], VolumeView { gpu_silhouettes: false, ..still }),
         ];
         let (ms, _) = bench.interleaved(Arc::new(head.labels.volume), labels, &configs, true)?;
-        push_group(&mut rows, "lenses", &configs, &ms, "labelled head phantom", "silhouette every frame; goal ≤ ×1.25");
+        push_group(&mut rows, "lenses", &names(&configs), &ms, "labelled head phantom", "silhouette every frame; goal ≤ ×1.25");
         replace_lenses(bench.off.world_mut(), &[]);
     }
 

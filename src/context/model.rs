@@ -62,6 +62,13 @@ impl ContextParams {
     /// Most useful ranges of the sliders.
     pub const KAPPA_T_MAX: f32 = 12.0;
     pub const KAPPA_S_MAX: f32 = 2.0;
+    /// Step of κt per key press in the app.
+    pub const KAPPA_T_STEP: f32 = 0.5;
+
+    /// κt moved by `delta`, kept within the slider's range.
+    pub fn with_kappa_t_step(self, delta: f32) -> Self {
+        Self { kappa_t: (self.kappa_t + delta).clamp(0.0, Self::KAPPA_T_MAX), ..self }
+    }
 
     /// Checks the parameters (finite, not negative).
     pub fn validated(self) -> Result<Self, String> {
@@ -239,6 +246,14 @@ mod tests {
         assert_eq!(eye_distance(10.0, o, d, c, 2.0), 0.5);
         assert_eq!(eye_distance(12.0, o, d, c, 2.0), 1.0);
         assert_eq!(eye_distance(1.0, o, d, c, 2.0), 0.0);
+    }
+
+    #[test]
+    fn kappa_t_steps_stay_in_range() {
+        let p = ContextParams { kappa_t: 0.2, ..Default::default() };
+        assert_eq!(p.with_kappa_t_step(-0.5).kappa_t, 0.0);
+        assert_eq!(p.with_kappa_t_step(0.5).kappa_t, 0.7);
+        assert_eq!(ContextParams { kappa_t: 11.8, ..p }.with_kappa_t_step(0.5).kappa_t, ContextParams::KAPPA_T_MAX);
     }
 
     #[test]

@@ -32,6 +32,8 @@ pub mod region_flags {
     pub const SHADING: u32 = 2;
     /// The occupancy bits of this region may be used to skip bricks.
     pub const OCCUPANCY: u32 = 4;
+    /// Context-preserving with λt, λs channels: their table follows the colours.
+    pub const LAMBDA: u32 = 8;
 }
 
 /// Scene features: which parts of the shader a scene needs (shader defs).

@@ -249,12 +249,15 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
     let plane_offset = out.planes.len() as u32;
     out.planes.extend(p.region.planes.iter().map(|pl| pl.normal.extend(pl.offset)));
     let lut_offset = out.lut.len() as u32;
+    let mut flags = 0;
     let (lut_a, lut_b, lut_width, labels) = match &p.lookup {
         PreparedLookup::Transfer { lut, a, b } => {
             out.lut.extend_from_slice(&lut.rgba);
-            // Context-preserving regions read (λt, λs) from the next `lut_width` texels.
-            if p.mode == Mode::Context {
+            // Context-preserving regions with λ channels read (λt, λs) from the next
+            // `lut_width` texels (without, both are 1 and nothing is read).
+            if p.mode == Mode::Context && lut.lambda.iter().any(|l| *l != [1.0, 1.0]) {
                 out.lut.extend(lut.lambda.iter().map(|l| [l[0], l[1], 0.0, 0.0]));
+                flags |= region_flags::LAMBDA;
             }
             (*a, *b, lut.rgba.len() as u32, false)
         }
@@ -263,7 +266,6 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
             (0.0, 0.0, table.len() as u32, true)
         }
     };
-    let mut flags = 0;
     if labels {
         flags |= region_flags::LABELS;
     }

@@ -11,6 +11,7 @@ pub mod orbit;
 pub mod panels;
 pub mod tf_editor;
 
+use crate::context::ContextParams;
 use std::path::PathBuf;
 
 use bevy::camera::visibility::RenderLayers;
@@ -44,6 +45,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("7", "oblique view"),
     ("P", "perspective / orthographic"),
     ("M", "next rendering mode"),
+    ("[ / ]", "context-preserving κt down / up (mode: context-preserving)"),
     ("Ctrl+O", "open a file"),
     ("Ctrl+S", "save the scene"),
     ("F12 or S", "save a screenshot (out/)"),
@@ -232,6 +234,13 @@ fn shortcuts(
             let modes = crate::region::Mode::ALL;
             let i = modes.iter().position(|m| *m == d.appearance.mode).unwrap_or(0);
             d.appearance.mode = modes[(i + 1) % modes.len()];
+        }
+    }
+    for (key, delta) in [(KeyCode::BracketLeft, -ContextParams::KAPPA_T_STEP), (KeyCode::BracketRight, ContextParams::KAPPA_T_STEP)] {
+        if keys.just_pressed(key)
+            && let Some(mut d) = datasets.iter_mut().nth(state.selected)
+        {
+            d.appearance.context = d.appearance.context.with_kappa_t_step(delta);
         }
     }
     let Ok(mut orbit) = cams.single_mut() else { return };

@@ -10,6 +10,7 @@ use bevy_egui::{EguiContexts, egui::Ui};
 use super::loading::{DatasetOrigin, LoadRequest, Loading, Session};
 use super::orbit::{OrbitCamera, PointerInViewport};
 use super::{AppState, DialogPurpose, MainCamera, SHORTCUTS, lenses, scene_bounds, set_viewport, tf_editor};
+use crate::context::{ContextParams, Power};
 use crate::dataset::{Dataset, GpuVolume, SceneLight, SceneRegions};
 use crate::region::{Light, Lookup, Mode, View};
 use crate::transfer::presets;
@@ -205,6 +206,7 @@ fn dataset_info(ui: &mut Ui, d: &Dataset) {
 
 fn transfer_panel(ui: &mut Ui, d: &mut Dataset, editor: &mut tf_editor::EditorState) {
     let hist = d.volume.stats.histogram.clone();
+    let lambda = d.appearance.mode == Mode::Context;
     match &mut d.appearance.lookup {
         Lookup::Transfer(tf) => {
             egui::ComboBox::from_label("preset").selected_text(tf.name.clone()).show_ui(ui, |ui| {
@@ -222,7 +224,7 @@ fn transfer_panel(ui: &mut Ui, d: &mut Dataset, editor: &mut tf_editor::EditorSt
                 ui.label(RichText::new(format!("⚠ preset for {u}, data in {v}")).color(Color32::YELLOW));
             }
             let mut edited = tf.clone();
-            if tf_editor::editor(ui, &mut edited, &hist, editor) {
+            if tf_editor::editor(ui, &mut edited, &hist, editor, lambda) {
                 *tf = edited;
             }
         }
@@ -253,6 +255,18 @@ fn rendering_panel(ui: &mut Ui, d: &mut Dataset, state: &mut AppState, light: &m
     if a.mode == Mode::Iso {
         let (lo, hi) = (d.volume.stats.min, d.volume.stats.max);
         ui.add(egui::Slider::new(&mut a.iso_value, lo..=hi).text("iso-value"));
+    }
+    if a.mode == Mode::Context {
+        let c = &mut a.context;
+        ui.add(egui::Slider::new(&mut c.kappa_t, 0.0..=ContextParams::KAPPA_T_MAX).text("κt (depth)"))
+            .on_hover_text("How far the view reaches into the volume ([ and ] step it)");
+        ui.add(egui::Slider::new(&mut c.kappa_s, 0.0..=ContextParams::KAPPA_S_MAX).text("κs (sharpness)"))
+            .on_hover_text("How sharp the boundary between cleared and kept is");
+        let mut exact = c.power == Power::Exact;
+        if ui.checkbox(&mut exact, "exact power (instead of Schlick's approximation)").changed() {
+            c.power = if exact { Power::Exact } else { Power::Schlick };
+        }
+        ui.label(RichText::new("λt, λs: curves in the transfer function editor").small().weak());
     }
     ui.add(egui::Slider::new(&mut a.step, 0.1..=2.0).logarithmic(true).text("step (voxels)"));
     ui.checkbox(&mut a.shading.enabled, "shading");

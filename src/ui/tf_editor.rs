@@ -1,9 +1,12 @@
 //! The transfer-function editor: opacity control points drawn over the (log) histogram,
-//! colour control points on a gradient bar beneath.
+//! colour control points on a gradient bar beneath. For the context-preserving mode the
+//! curve can show the λt or λs channel instead (section 5 of Bruckner et al. 2005: 1
+//! everywhere until edited; λt = 0 makes a value range impenetrable, λs = 0 reduces it
+//! to gradient-magnitude modulation).
 //!
-//! Drag a point to move it; double-click the plot to add an opacity point (the colour
-//! bar to add a colour point); right-click a point to remove it (the ends stay); click a
-//! colour point to pick its colour.
+//! Drag a point to move it; double-click the plot to add a point (the colour bar to add
+//! a colour point); right-click a point to remove it (the ends stay); click a colour
+//! point to pick its colour.
 
 use bevy_egui::egui::{self, Color32, Pos2, Rect, Sense, Stroke, StrokeKind, pos2, vec2};
 
@@ -15,6 +18,48 @@ use crate::volume::Histogram;
 pub struct EditorState {
     /// Colour point whose picker is open.
     pub picking: Option<usize>,
+    /// The scalar channel the curve edits.
+    pub channel: Channel,
+}
+
+/// The scalar channels of a transfer function.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Channel {
+    #[default]
+    Opacity,
+    LambdaT,
+    LambdaS,
+}
+
+impl Channel {
+    pub const ALL: [Channel; 3] = [Channel::Opacity, Channel::LambdaT, Channel::LambdaS];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Channel::Opacity => "opacity",
+            Channel::LambdaT => "λt",
+            Channel::LambdaS => "λs",
+        }
+    }
+
+    /// The channel's points; an untouched λ channel (no points: 1 everywhere) gets its
+    /// two ends at 1, the same function (the editor works on a copy that is kept only
+    /// when edited).
+    fn points(self, tf: &mut TransferFunction, lo: f64, hi: f64) -> &mut Vec<OpacityPoint> {
+        let (a, b) = match tf.space {
+            ValueSpace::Absolute => (lo, hi),
+            ValueSpace::Relative => (0.0, 1.0),
+        };
+        let points = match self {
+            Channel::Opacity => return &mut tf.opacity,
+            Channel::LambdaT => &mut tf.lambda_t,
+            Channel::LambdaS => &mut tf.lambda_s,
+        };
+        if points.is_empty() {
+            points.extend([OpacityPoint(a, 1.0), OpacityPoint(b, 1.0)]);
+        }
+        points
+    }
 }
 
 /// Display colour of an sRGB triple.
@@ -22,19 +67,38 @@ fn color32(c: [f32; 3]) -> Color32 {
     Color32::from_rgb((c[0] * 255.0) as u8, (c[1] * 255.0) as u8, (c[2] * 255.0) as u8)
 }
 
-/// Shows the editor; returns whether the function changed.
-pub fn editor(ui: &mut egui::Ui, tf: &mut TransferFunction, hist: &Histogram, state: &mut EditorState) -> bool {
+/// Shows the editor; `lambda` offers the λ channels. Returns whether the function changed.
+pub fn editor(ui: &mut egui::Ui, tf: &mut TransferFunction, hist: &Histogram, state: &mut EditorState, lambda: bool) -> bool {
     let (lo, hi) = (hist.min, hist.max.max(hist.min + 1e-9));
     // Control points live in value space or in fractions of the range.
-    let to_frac = |v: f64| match tf.space {
+    let space = tf.space.clone();
+    let to_frac = |v: f64| match space {
         ValueSpace::Absolute => ((v - lo) / (hi - lo)) as f32,
         ValueSpace::Relative => v as f32,
     };
-    let from_frac = |f: f32| match tf.space {
+    let from_frac = |f: f32| match space {
         ValueSpace::Absolute => lo + f as f64 * (hi - lo),
         ValueSpace::Relative => f as f64,
     };
     let mut changed = false;
+    if !lambda {
+        state.channel = Channel::Opacity;
+    } else {
+        ui.horizontal(|ui| {
+            ui.label("curve");
+            for c in Channel::ALL {
+                ui.selectable_value(&mut state.channel, c, c.name());
+            }
+            if state.channel != Channel::Opacity && ui.small_button("reset to 1").clicked() {
+                match state.channel {
+                    Channel::LambdaT => tf.lambda_t.clear(),
+                    _ => tf.lambda_s.clear(),
+                }
+                changed = true;
+            }
+        });
+    }
+    let channel = state.channel;
     let width = ui.available_width().max(120.0);
     let (resp, painter) = ui.allocate_painter(vec2(width, 130.0), Sense::click());
     let r = resp.rect;
@@ -53,23 +117,24 @@ pub fn editor(ui: &mut egui::Ui, tf: &mut TransferFunction, hist: &Histogram, st
         && let Some(p) = resp.interact_pointer_pos()
     {
         let (f, a) = from_screen(p);
-        tf.opacity.push(OpacityPoint(from_frac(f), a));
-        tf.opacity.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let points = channel.points(tf, lo, hi);
+        points.push(OpacityPoint(from_frac(f), a));
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
         changed = true;
     }
-    // Opacity points.
-    let n = tf.opacity.len();
+    let points = channel.points(tf, lo, hi);
+    let n = points.len();
     let mut remove = None;
     let mut line = Vec::with_capacity(n);
     for i in 0..n {
-        let OpacityPoint(v, a) = tf.opacity[i];
+        let OpacityPoint(v, a) = points[i];
         let c = to_screen(to_frac(v), a);
         let handle = ui.interact(Rect::from_center_size(c, vec2(12.0, 12.0)), resp.id.with(("opacity", i)), Sense::click_and_drag());
         if handle.dragged() {
             let d = handle.drag_delta();
             let f = (to_frac(v) + d.x / r.width()).clamp(0.0, 1.0);
             let a = (a - d.y / r.height()).clamp(0.0, 1.0);
-            tf.opacity[i] = OpacityPoint(from_frac(f), a);
+            points[i] = OpacityPoint(from_frac(f), a);
             changed = true;
         }
         if handle.secondary_clicked() && n > 2 {
@@ -78,14 +143,14 @@ pub fn editor(ui: &mut egui::Ui, tf: &mut TransferFunction, hist: &Histogram, st
         let fill = if handle.hovered() || handle.dragged() { Color32::YELLOW } else { Color32::WHITE };
         painter.circle_filled(c, 4.5, fill);
         line.push(c);
-        handle.on_hover_text(format!("{v:.1}: opacity {a:.3}"));
+        handle.on_hover_text(format!("{v:.1}: {} {a:.3}", channel.name()));
     }
     if let Some(i) = remove {
-        tf.opacity.remove(i);
+        points.remove(i);
         changed = true;
     }
     if changed {
-        tf.opacity.sort_by(|a, b| a.0.total_cmp(&b.0));
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
     }
     painter.line(line, Stroke::new(1.5, Color32::from_rgb(120, 190, 255)));
     painter.rect_stroke(r, 2.0, Stroke::new(1.0, Color32::GRAY), StrokeKind::Inside);
