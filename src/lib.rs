@@ -2,11 +2,12 @@
 //!
 //! The crate is organised by technique (see `../shared/DESIGN.md` and the README):
 //! [`volume`] holds the data model, readers and phantoms; [`transfer`] the transfer
-//! functions; [`region`] the geometry every renderer shares; [`lens`] the magic volume lenses; [`context`] context-preserving rendering; [`reference`] the CPU
+//! functions; [`region`] the geometry every renderer shares; [`lens`] the magic volume lenses; [`context`] context-preserving rendering; [`clip`] clip planes and boxes; [`reference`] the CPU
 //! reference renderer; [`dataset`] the dataset entities that become regions; [`render`]
 //! the GPU ray caster that packs and draws them; [`scene`] scene files; [`ui`] the
 //! desktop app.
 
+pub mod clip;
 pub mod context;
 pub mod dataset;
 pub mod lens;

@@ -9,6 +9,8 @@
 //! 8-bit sRGB: the mean absolute difference must stay below 1 level and 99 % of the
 //! pixels within 6 levels; a few pixels where a ray grazes a steep edge may differ more.
 
+#[path = "gpu/clip.rs"]
+mod clip;
 mod common;
 #[path = "gpu/context.rs"]
 mod context;
@@ -47,8 +49,12 @@ impl Gpu {
     }
 
     fn show(&mut self, volume: Arc<Volume>, appearance: Appearance, camera: &FocalCamera) -> image::RgbaImage {
+        self.show_dataset(Dataset::new(volume, appearance), Transform::default(), camera)
+    }
+
+    fn show_dataset(&mut self, dataset: Dataset, transform: Transform, camera: &FocalCamera) -> image::RgbaImage {
         self.clear();
-        self.off.world_mut().spawn((Dataset::new(volume, appearance), Transform::default()));
+        self.off.world_mut().spawn((dataset, transform));
         self.off.set_camera(camera);
         self.off.capture().unwrap_or_else(|e| panic!("{e}"))
     }
@@ -322,7 +328,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [(&str, fn(&mut Gpu)); 15] = [
+    let tests: [(&str, fn(&mut Gpu)); 17] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -338,6 +344,8 @@ fn main() {
         ("feature_lens_matches_the_reference", lenses::feature_lens_matches_the_reference),
         ("context_matches_the_reference", context::context_matches_the_reference),
         ("kappa_t_zero_is_dvr_on_the_gpu", context::kappa_t_zero_is_dvr_on_the_gpu),
+        ("clipping_matches_the_reference", clip::clipping_matches_the_reference),
+        ("a_clip_box_inside_the_engine_makes_minip_useful", clip::a_clip_box_inside_the_engine_makes_minip_useful),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

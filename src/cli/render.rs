@@ -161,14 +161,7 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
             early_termination: !args.no_early_termination,
             lens_antialias: true,
         },
-        datasets: vec![DatasetSpec {
-            name: None,
-            source,
-            appearance,
-            translation: (0.0, 0.0, 0.0),
-            rotation_deg: (0.0, 0.0, 0.0),
-            visible: true,
-        }],
+        datasets: vec![DatasetSpec::of(source, appearance)],
         camera,
         lenses: Vec::new(),
         frames: Vec::new(),
@@ -194,14 +187,7 @@ pub fn run_headless(volume: Option<&Path>, out: &Path) -> Result<(), String> {
         None => SceneFile::parse(DEFAULT_SCENE, "assets/scenes/default.ron")?,
         Some(v) => {
             let mut s = SceneFile::parse(DEFAULT_SCENE, "assets/scenes/default.ron")?;
-            s.datasets = vec![DatasetSpec {
-                name: None,
-                source: SourceSpec::File(v.to_path_buf()),
-                appearance: AppearanceSpec::default(),
-                translation: (0.0, 0.0, 0.0),
-                rotation_deg: (0.0, 0.0, 0.0),
-                visible: true,
-            }];
+            s.datasets = vec![DatasetSpec::of(SourceSpec::File(v.to_path_buf()), AppearanceSpec::default())];
             s
         }
     };

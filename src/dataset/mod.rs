@@ -13,6 +13,7 @@ use std::sync::Arc;
 
 use bevy::prelude::*;
 
+use crate::clip::Clipping;
 use crate::region::{Appearance, Light, Region, RenderScene};
 use crate::volume::{LabelTable, Volume};
 
@@ -25,11 +26,13 @@ pub struct Dataset {
     pub visible: bool,
     /// Names and colours of the labels, for label volumes.
     pub labels: Option<Arc<LabelTable>>,
+    /// Clip planes and box (in the dataset's frame).
+    pub clip: Clipping,
 }
 
 impl Dataset {
     pub fn new(volume: Arc<Volume>, appearance: Appearance) -> Self {
-        Self { volume, appearance, visible: true, labels: None }
+        Self { volume, appearance, visible: true, labels: None, clip: Clipping::default() }
     }
 }
 
@@ -73,7 +76,7 @@ pub fn collect_regions(
         }
         let volume = gpu.map(|g| g.volume.clone()).unwrap_or_else(|| d.volume.clone());
         let index = scene.volumes.len();
-        scene.regions.push(Region::volume_box_at(&volume.grid, transform.affine(), index, index));
+        scene.regions.push(Region::dataset(&volume.grid, transform.affine(), &d.clip, index));
         scene.volumes.push(volume);
         scene.appearances.push(d.appearance.clone());
     }

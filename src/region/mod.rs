@@ -70,6 +70,14 @@ impl Region {
         Region { planes: box_planes(&world_to_voxel, Vec3::splat(-0.5), grid.dims.as_vec3() - 0.5), world_to_voxel, volume, appearance }
     }
 
+    /// A dataset's region: its volume's box placed by `transform`, cut by its clipping
+    /// (one region per dataset; the volume and appearance share the index).
+    pub fn dataset(grid: &Grid, transform: Affine3A, clip: &crate::clip::Clipping, index: usize) -> Region {
+        let mut region = Region::volume_box_at(grid, transform, index, index);
+        region.planes.extend(clip.world_planes(&transform));
+        region
+    }
+
     /// Adds a cutting plane (keeps the part with `normal · p ≤ offset`).
     pub fn clipped(mut self, plane: Plane) -> Region {
         self.planes.push(plane);

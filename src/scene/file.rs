@@ -24,6 +24,7 @@ use std::path::PathBuf;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use crate::clip::Clipping;
 use crate::context::ContextParams;
 
 use crate::region::{Light, Mode, Shading, View};
@@ -134,6 +135,28 @@ pub struct DatasetSpec {
     pub rotation_deg: (f32, f32, f32),
     #[serde(default = "yes")]
     pub visible: bool,
+    /// Clip planes and box, in the dataset's frame (mm).
+    #[serde(default, skip_serializing_if = "is_unclipped")]
+    pub clip: Clipping,
+}
+
+impl DatasetSpec {
+    /// A dataset from `source` with `appearance`, unnamed, unmoved, visible, unclipped.
+    pub fn of(source: SourceSpec, appearance: AppearanceSpec) -> Self {
+        Self {
+            name: None,
+            source,
+            appearance,
+            translation: (0.0, 0.0, 0.0),
+            rotation_deg: (0.0, 0.0, 0.0),
+            visible: true,
+            clip: Clipping::default(),
+        }
+    }
+}
+
+fn is_unclipped(c: &Clipping) -> bool {
+    *c == Clipping::default()
 }
 
 /// How a dataset looks.
@@ -308,6 +331,11 @@ pub enum Change {
     Context {
         dataset: usize,
         context: ContextParams,
+    },
+    /// Replaces the clip planes and box.
+    Clip {
+        dataset: usize,
+        clip: Clipping,
     },
     Visible {
         dataset: usize,

@@ -1,5 +1,7 @@
 //! From a scene file to volumes, appearances and cameras.
 
+use crate::clip::Clipping;
+use crate::dataset::Dataset;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -22,7 +24,21 @@ pub struct LoadedDataset {
     pub table: Option<LabelTable>,
     pub transform: Affine3A,
     pub visible: bool,
+    pub clip: Clipping,
     pub spec: DatasetSpec,
+}
+
+impl LoadedDataset {
+    /// The dataset entity's component.
+    pub fn component(&self) -> Dataset {
+        Dataset {
+            volume: self.volume.clone(),
+            appearance: self.appearance.clone(),
+            visible: self.visible,
+            labels: self.table.clone().map(Arc::new),
+            clip: self.clip.clone(),
+        }
+    }
 }
 
 /// A path of the scene file resolved against the scene's folder.
@@ -56,7 +72,7 @@ fn load_dataset(spec: &DatasetSpec, base: &Path, options: &ReadOptions) -> Resul
             let h = head::generate(*resolution)?;
             let table = h.labels.table.clone();
             let app = appearance(&spec.appearance, &h.labels.volume, Some(&table), base)?;
-            return Ok(dataset(spec, h.labels.volume, app, Some(table)));
+            return dataset(spec, h.labels.volume, app, Some(table));
         }
         SourceSpec::File(p) => {
             let p = resolve(base, p);
@@ -77,27 +93,28 @@ fn load_dataset(spec: &DatasetSpec, base: &Path, options: &ReadOptions) -> Resul
             };
             let lv = LabelVolume::from_volume(volume, table)?;
             let app = appearance(&spec.appearance, &lv.volume, Some(&lv.table), base)?;
-            Ok(dataset(spec, lv.volume, app, Some(lv.table)))
+            dataset(spec, lv.volume, app, Some(lv.table))
         }
         None => {
             let app = appearance(&spec.appearance, &volume, None, base)?;
-            Ok(dataset(spec, volume, app, None))
+            dataset(spec, volume, app, None)
         }
     }
 }
 
-fn dataset(spec: &DatasetSpec, volume: Volume, appearance: Appearance, table: Option<LabelTable>) -> LoadedDataset {
+fn dataset(spec: &DatasetSpec, volume: Volume, appearance: Appearance, table: Option<LabelTable>) -> Result<LoadedDataset, String> {
     let (rx, ry, rz) = spec.rotation_deg;
     let rotation = Quat::from_euler(EulerRot::XYZ, rx.to_radians(), ry.to_radians(), rz.to_radians());
-    LoadedDataset {
+    Ok(LoadedDataset {
         name: spec.name.clone().unwrap_or_else(|| volume.name.clone()),
         volume: Arc::new(volume),
         appearance,
         table,
         transform: Affine3A::from_rotation_translation(rotation, vec3(spec.translation)),
         visible: spec.visible,
+        clip: spec.clip.clone().validated()?,
         spec: spec.clone(),
-    }
+    })
 }
 
 /// Label styles from the table, with the spec's opacity and overrides.
@@ -218,6 +235,7 @@ pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneF
         Change::Iso { dataset, value } => datasets[get(*dataset)?].appearance.iso_value = *value,
         Change::Shading { dataset, enabled } => datasets[get(*dataset)?].appearance.shading.enabled = *enabled,
         Change::Context { dataset, context } => datasets[get(*dataset)?].appearance.context = context.validated()?,
+        Change::Clip { dataset, clip } => datasets[get(*dataset)?].clip = clip.clone().validated()?,
         Change::Visible { dataset, visible } => datasets[get(*dataset)?].visible = *visible,
         Change::LabelOpacity { dataset, label, opacity } => match &mut datasets[get(*dataset)?].appearance.lookup {
             Lookup::Labels(styles) => {
@@ -247,7 +265,7 @@ pub fn render_scene(datasets: &[LoadedDataset], scene: &SceneFile) -> RenderScen
     };
     for d in datasets.iter().filter(|d| d.visible) {
         let i = out.volumes.len();
-        out.regions.push(Region::volume_box_at(&d.volume.grid, d.transform, i, i));
+        out.regions.push(Region::dataset(&d.volume.grid, d.transform, &d.clip, i));
         out.volumes.push(d.volume.clone());
         out.appearances.push(d.appearance.clone());
     }
@@ -272,6 +290,29 @@ mod tests {
         assert_eq!(d2[0].appearance.mode, crate::region::Mode::Mip);
         assert!(apply(&Change::Visible { dataset: 5, visible: false }, &mut d2, &mut s2, Path::new(".")).is_err());
         assert_eq!(render_scene(&d2, &s2).regions.len(), 2);
+    }
+
+    #[test]
+    fn clipping_comes_from_the_scene_and_its_frames() {
+        let text = "(datasets: [(source: Phantom(kind: sphere, resolution: 24), translation: (5.0, 0.0, 0.0),
+            clip: (planes: [(point: (0.0, 0.0, 0.0), normal: (1.0, 0.0, 0.0))], box: Some((min: (-5.0, -5.0, -5.0), max: (5.0, 5.0, 5.0)))))])";
+        let s = SceneFile::parse(text, "t").unwrap();
+        let mut d = load_datasets(&s, Path::new(".")).unwrap();
+        // The box's 6 planes, the clip plane and its 6 box faces.
+        let region = &render_scene(&d, &s).regions[0];
+        assert_eq!(region.planes.len(), 6 + 1 + 6);
+        // In the dataset's frame x ≤ 0 is kept; the dataset sits at x + 5 in the world.
+        assert!(region.contains(Vec3::new(4.0, 0.0, 0.0)) && !region.contains(Vec3::new(6.0, 0.0, 0.0)));
+        let mut s2 = s.clone();
+        apply(&Change::Clip { dataset: 0, clip: Clipping::default() }, &mut d, &mut s2, Path::new(".")).unwrap();
+        assert_eq!(render_scene(&d, &s2).regions[0].planes.len(), 6);
+        // A clip that cuts nothing sensibly is an error naming the dataset.
+        let bad = SceneFile::parse("(datasets: [(source: Phantom(kind: sphere, resolution: 24), clip: (planes: [(point: (0.0, 0.0, 0.0), normal: (0.0, 0.0, 0.0))]))])", "t").unwrap();
+        let e = load_datasets(&bad, Path::new(".")).unwrap_err();
+        assert!(e.contains("dataset 0") && e.contains("clip plane 0"), "{e}");
+        // Saved and read back.
+        let round = SceneFile::parse(&s.to_ron().unwrap(), "again").unwrap();
+        assert_eq!(round.datasets[0].clip, s.datasets[0].clip);
     }
 
     #[test]

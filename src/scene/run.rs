@@ -3,8 +3,6 @@
 
 use std::path::{Path, PathBuf};
 
-use std::sync::Arc;
-
 use bevy::prelude::*;
 
 use super::file::{FrameSpec, SceneFile};
@@ -117,7 +115,7 @@ impl GpuRun {
 }
 
 fn dataset_component(d: &LoadedDataset) -> Dataset {
-    Dataset { volume: d.volume.clone(), appearance: d.appearance.clone(), visible: d.visible, labels: d.table.clone().map(Arc::new) }
+    d.component()
 }
 
 fn transform(d: &LoadedDataset) -> Transform {

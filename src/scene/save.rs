@@ -2,6 +2,7 @@
 //! appearance spelled out (transfer functions inline, label styles as overrides), the
 //! camera as an explicit pose, the lenses in stack order.
 
+use crate::clip::Clipping;
 use std::path::Path;
 
 use glam::{EulerRot, Quat, Vec3};
@@ -17,6 +18,7 @@ pub struct DatasetState<'a> {
     pub translation: Vec3,
     pub rotation: Quat,
     pub visible: bool,
+    pub clip: &'a Clipping,
 }
 
 /// The appearance as a spec.
@@ -85,6 +87,7 @@ pub fn scene_file(
                 translation: d.translation.into(),
                 rotation_deg: (x.to_degrees(), y.to_degrees(), z.to_degrees()),
                 visible: d.visible,
+                clip: d.clip.clone(),
             }
         })
         .collect();
@@ -136,6 +139,7 @@ mod tests {
                 translation: Vec3::new(1.0, 2.0, 3.0),
                 rotation: Quat::IDENTITY,
                 visible: d.visible,
+                clip: &d.clip,
             })
             .collect();
         let cam = View::Left.frame(Vec3::ZERO, 20.0, true);

@@ -8,8 +8,6 @@
 
 use std::path::{Path, PathBuf};
 
-use std::sync::Arc;
-
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
 
@@ -70,14 +68,10 @@ pub enum LoadRequest {
 pub fn scene_for_file(path: &Path) -> SceneFile {
     let labels = crate::volume::readers::label_table::read_sidecars(path).map(|t| !t.is_empty()).unwrap_or(false);
     let mut scene = SceneFile::parse("()", "empty").unwrap_or_else(|_| unreachable!("an empty scene parses"));
-    scene.datasets.push(DatasetSpec {
-        name: None,
-        source: SourceSpec::File(path.to_path_buf()),
-        appearance: AppearanceSpec { labels: labels.then(Default::default), ..Default::default() },
-        translation: (0.0, 0.0, 0.0),
-        rotation_deg: (0.0, 0.0, 0.0),
-        visible: true,
-    });
+    scene.datasets.push(DatasetSpec::of(
+        SourceSpec::File(path.to_path_buf()),
+        AppearanceSpec { labels: labels.then(Default::default), ..Default::default() },
+    ));
     scene
 }
 
@@ -140,12 +134,7 @@ pub fn finish_loads(
                 }
                 for d in &datasets {
                     commands.spawn((
-                        Dataset {
-                            volume: d.volume.clone(),
-                            appearance: d.appearance.clone(),
-                            visible: d.visible,
-                            labels: d.table.clone().map(Arc::new),
-                        },
+                        d.component(),
                         Transform::from_matrix(Mat4::from(d.transform)),
                         DatasetOrigin(d.spec.clone()),
                         Name::new(d.name.clone()),

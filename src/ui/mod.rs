@@ -5,6 +5,7 @@
 //! command line; loading runs in the background with a progress bar and a failed load
 //! leaves the current data in place. See [`SHORTCUTS`] for the keys.
 
+pub mod clip_panel;
 pub mod lenses;
 pub mod loading;
 pub mod orbit;

@@ -77,6 +77,7 @@ pub fn ui(
         });
     });
 
+    let view_forward = cams.single().map(|(o, _)| o.camera().forward()).unwrap_or(Vec3::NEG_Z);
     let mut ds: Vec<_> = datasets.iter_mut().collect();
     ds.sort_by_key(|(e, ..)| *e);
     let selected = state.selected.min(ds.len().saturating_sub(1));
@@ -98,9 +99,19 @@ pub fn ui(
                     dataset_info(ui, d);
                 }
             });
-            if let Some((_, d, ..)) = ds.get_mut(selected) {
+            if let Some((_, d, _, _, transform)) = ds.get_mut(selected) {
                 egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| transfer_panel(ui, d, &mut state.editor));
                 egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| rendering_panel(ui, d, &mut state, &mut light));
+                egui::CollapsingHeader::new("Clipping").default_open(false).show(ui, |ui| {
+                    // Planes live in the dataset's frame: the view direction taken there.
+                    let view_dir = transform.rotation.inverse() * view_forward;
+                    let bounds = d.volume.grid.world_bounds();
+                    let mut clip = d.clip.clone();
+                    super::clip_panel::panel(ui, &mut clip, bounds, view_dir);
+                    if clip != d.clip {
+                        d.clip = clip;
+                    }
+                });
             }
             egui::CollapsingHeader::new("Lenses").default_open(true).show(ui, |ui| lenses::panel(ui, &mut lens_params));
             egui::CollapsingHeader::new("Camera").default_open(true).show(ui, |ui| {
@@ -373,6 +384,7 @@ fn save_scene(
             translation: t.translation,
             rotation: t.rotation,
             visible: d.visible,
+            clip: &d.clip,
         })
         .collect();
     let camera = camera.ok_or("no camera")?;
