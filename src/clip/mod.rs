@@ -9,6 +9,8 @@
 //! ([`Clipping::world_planes`]), so the CPU reference and the ray caster clip alike with
 //! no code of their own.
 
+pub mod gizmo;
+
 use glam::{Affine3A, Vec3};
 use serde::{Deserialize, Serialize};
 

@@ -62,6 +62,26 @@ impl Camera {
         self.rotation * Vec3::X
     }
 
+    /// Normalised device coordinates (x right, y up, −1…1 across the image) of a world
+    /// point seen in an image of aspect `width / height`; `None` behind a perspective
+    /// camera. The inverse of [`Self::ray`].
+    pub fn to_ndc(&self, p: Vec3, aspect: f32) -> Option<(f32, f32)> {
+        let q = self.rotation.inverse() * (p - self.position);
+        match self.projection {
+            Projection::Perspective { fov_y } => {
+                let k = (fov_y * 0.5).tan();
+                (q.z < -1e-6).then(|| (q.x / (-q.z * k * aspect), q.y / (-q.z * k)))
+            }
+            Projection::Orthographic { height } => Some((q.x / (height * 0.5 * aspect), q.y / (height * 0.5))),
+        }
+    }
+
+    /// Pixel position (from the top left) of a world point in a `width × height` image.
+    pub fn to_pixel(&self, p: Vec3, width: f32, height: f32) -> Option<glam::Vec2> {
+        let (x, y) = self.to_ndc(p, width / height.max(1e-6))?;
+        Some(glam::Vec2::new((x + 1.0) * 0.5 * width, (1.0 - y) * 0.5 * height))
+    }
+
     /// The ray through pixel position `(px, py)` of a `width × height` image.
     pub fn ray(&self, px: f32, py: f32, width: u32, height: u32) -> Ray {
         let aspect = width as f32 / height as f32;
@@ -258,7 +278,7 @@ mod tests {
                     if c & 2 == 0 { lo.y } else { hi.y },
                     if c & 4 == 0 { lo.z } else { hi.z },
                 );
-                let (x, y) = project(&cam, p, 1.5);
+                let (x, y) = cam.to_ndc(p, 1.5).unwrap();
                 assert!(x.abs() <= 1.0 && y.abs() <= 1.0, "{ortho} {x} {y}");
                 widest = widest.max(x.abs()).max(y.abs());
             }
@@ -285,15 +305,18 @@ mod tests {
         assert_eq!("-x".parse::<View>().unwrap(), View::Left);
     }
 
-    /// Normalised device coordinates of a world point.
-    fn project(cam: &Camera, p: Vec3, aspect: f32) -> (f32, f32) {
-        let q = cam.rotation.inverse() * (p - cam.position);
-        match cam.projection {
-            Projection::Perspective { fov_y } => {
-                let k = (fov_y * 0.5).tan();
-                (q.x / (-q.z * k * aspect), q.y / (-q.z * k))
+    #[test]
+    fn pixels_of_points_on_a_pixel_ray_are_that_pixel() {
+        let (lo, hi) = (Vec3::new(-10.0, -4.0, -2.0), Vec3::new(10.0, 4.0, 2.0));
+        for ortho in [false, true] {
+            let cam = View::Oblique.frame_box(lo, hi, 1.5, ortho);
+            for (px, py) in [(10.5, 20.5), (150.0, 99.5), (299.0, 0.5)] {
+                let ray = cam.ray(px, py, 300, 200);
+                let p = cam.to_pixel(ray.at(37.0), 300.0, 200.0).unwrap();
+                assert!((p.x - px).abs() < 1e-2 && (p.y - py).abs() < 1e-2, "{ortho}: {p} vs {px}, {py}");
             }
-            Projection::Orthographic { height } => (q.x / (height * 0.5 * aspect), q.y / (height * 0.5)),
         }
+        let cam = View::Oblique.frame_box(lo, hi, 1.5, false);
+        assert!(cam.to_pixel(cam.position - cam.forward() * 5.0, 300.0, 200.0).is_none());
     }
 }

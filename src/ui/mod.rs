@@ -5,6 +5,7 @@
 //! command line; loading runs in the background with a progress bar and a failed load
 //! leaves the current data in place. See [`SHORTCUTS`] for the keys.
 
+pub mod clip_gizmo;
 pub mod clip_panel;
 pub mod lenses;
 pub mod loading;
@@ -39,6 +40,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Drag a lens", "move it (its rim: radius; its dashed ring: border)"),
     ("Wheel over a lens", "magnification (rate, field of view)"),
     ("Delete / Esc", "remove the selected lens / stop drawing"),
+    ("Drag a clip handle", "move the clip plane along its normal (Clipping panel adds planes)"),
     ("V", "fly-through on / off (drag: look; arrows, Page Up / Down, wheel: move)"),
     ("Double-click", "centre on the point under the cursor"),
     ("R", "reset the camera"),
@@ -118,6 +120,7 @@ impl Plugin for FocalAppPlugin {
             .insert_resource(AppState { screenshot_and_exit: self.screenshot_and_exit.clone(), ..Default::default() })
             .init_resource::<PointerInViewport>()
             .init_resource::<lenses::LensUi>()
+            .init_resource::<clip_gizmo::ClipGizmo>()
             .add_systems(
                 Startup,
                 move |mut commands: Commands, mut egui: ResMut<EguiGlobalSettings>, mut load: MessageWriter<LoadRequest>| {
@@ -133,6 +136,7 @@ impl Plugin for FocalAppPlugin {
                 (
                     lenses::lens_input,
                     lenses::lens_keys,
+                    clip_gizmo::clip_input,
                     orbit::orbit_input,
                     orbit::fly_keys,
                     shortcuts,

@@ -31,6 +31,7 @@ pub fn ui(
     regions: Res<SceneRegions>,
     mut load: MessageWriter<LoadRequest>,
     mut lens_params: lenses::LensParams,
+    clip_gizmo: Res<super::clip_gizmo::ClipGizmo>,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(
@@ -131,6 +132,13 @@ pub fn ui(
     pointer.inside = over_free && !ctx.is_pointer_over_egui() && !ctx.egui_is_using_pointer();
     pointer.height = free.height();
     lenses::overlay(&ctx, free, &mut lens_params, &regions);
+    {
+        let mut rows: Vec<_> = datasets.iter().map(|(e, d, _, _, t)| (e, d, t)).collect();
+        rows.sort_by_key(|(e, ..)| *e);
+        let chosen = rows.get(state.selected.min(rows.len().saturating_sub(1))).copied();
+        let camera = cams.single().ok().map(|(o, _)| o.camera());
+        super::clip_gizmo::overlay(&ctx, free, &clip_gizmo, chosen, camera);
+    }
 
     if state.show_help {
         let mut open = true;
