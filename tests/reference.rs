@@ -146,6 +146,37 @@ fn picking_finds_the_first_visible_surface() {
 }
 
 #[test]
+fn picking_names_the_label_in_front_and_hidden_labels_let_the_next_through() {
+    let head = phantom::head::generate(64).unwrap();
+    let ids: Vec<u32> = head.labels.present_ids().into_iter().map(|(id, _)| id).collect();
+    let mut styles = focal::transfer::LabelTransfer::from_table(&head.labels.table, ids.iter().copied(), 0.9);
+    let v = Arc::new(head.labels.volume);
+    let (lo, hi) = v.grid.world_bounds();
+    // From the front through the middle of the head.
+    let centre = (lo + hi) * 0.5;
+    let ray = focal::region::Ray { origin: Vec3::new(centre.x + 3.0, lo.y - 50.0, centre.z + 10.0), dir: Vec3::Y };
+    let picked = |styles: &focal::transfer::LabelTransfer| {
+        let a = Appearance { lookup: Lookup::Labels(styles.clone()), ..Appearance::new(Mode::Dvr, opaque_ramp()) };
+        let scene = RenderScene::single(v.clone(), a);
+        let hit = pick(&scene, ray).unwrap().expect("the head is hit");
+        (focal::reference::label_at(&scene, &hit).expect("a label volume"), hit.position.y)
+    };
+    let (first, y1) = picked(&styles);
+    assert!(first != 0 && ids.contains(&first), "{first}");
+    // Hide it: the pick goes deeper, to another label.
+    if let Some(s) = styles.styles.get_mut(&first) {
+        s.visible = false;
+    }
+    let (second, y2) = picked(&styles);
+    assert!(second != first && second != 0 && y2 > y1, "{first} at {y1}, then {second} at {y2}");
+    // Not a label volume: no label.
+    let ct = Arc::new(Phantom::Head.generate(48).unwrap());
+    let scene = RenderScene::single(ct, Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap()));
+    let hit = pick(&scene, ray).unwrap().expect("hit");
+    assert_eq!(focal::reference::label_at(&scene, &hit), None);
+}
+
+#[test]
 fn clip_planes_cut_the_region() {
     let dims = UVec3::new(24, 20, 16);
     let v = noise_volume(dims, false);

@@ -90,6 +90,18 @@ pub struct Hit {
     pub region: usize,
 }
 
+/// The label id at a hit on a label volume (its nearest voxel: the label whose sample
+/// made the ray opaque there); `None` on other regions.
+pub fn label_at(scene: &RenderScene, hit: &Hit) -> Option<u32> {
+    let region = scene.regions.get(hit.region)?;
+    if !matches!(scene.appearances.get(region.appearance)?.lookup, crate::region::Lookup::Labels(_)) {
+        return None;
+    }
+    let volume = scene.volumes.get(region.volume)?;
+    let q = region.world_to_voxel.transform_point3(hit.position);
+    Some(crate::volume::sample::VolumeSampler::of(volume).nearest(q) as u32)
+}
+
 /// First visible point along `ray` under the scene's transfer functions.
 pub fn pick(scene: &RenderScene, ray: Ray) -> Result<Option<Hit>, String> {
     let regions = prepare(scene)?;

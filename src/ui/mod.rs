@@ -333,6 +333,8 @@ fn centre_on_double_click(
     regions: Res<SceneRegions>,
     mut last: Local<(f64, Vec2)>,
     mut cams: Query<(&mut OrbitCamera, &Camera), With<MainCamera>>,
+    mut state: ResMut<AppState>,
+    datasets: Query<(Entity, &crate::dataset::Dataset, Option<&crate::dataset::GpuVolume>)>,
 ) {
     let Ok(window) = windows.single() else { return };
     if !pointer.inside {
@@ -345,6 +347,17 @@ fn centre_on_double_click(
     let ray = orbit.camera().ray(p.x, p.y, size.x.max(1.0) as u32, size.y.max(1.0) as u32);
     if let Ok(Some(hit)) = crate::reference::pick(&regions.scene, ray) {
         orbit.target = hit.position;
+        // On a label volume, the label there is picked (named and marked in its list).
+        let picked = crate::reference::label_at(&regions.scene, &hit).and_then(|id| {
+            let volume = regions.scene.regions.get(hit.region).and_then(|r| regions.scene.volumes.get(r.volume))?;
+            let (entity, ..) = datasets.iter().find(|(_, d, gpu)| {
+                std::sync::Arc::ptr_eq(&d.volume, volume) || gpu.is_some_and(|g| std::sync::Arc::ptr_eq(&g.volume, volume))
+            })?;
+            Some((entity, id))
+        });
+        if state.editor.picked_label != picked {
+            state.editor.picked_label = picked;
+        }
     }
 }
 

@@ -100,8 +100,11 @@ pub fn ui(
                     dataset_info(ui, d);
                 }
             });
-            if let Some((_, d, _, _, transform)) = ds.get_mut(selected) {
-                egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| transfer_panel(ui, d, &mut state.editor));
+            if let Some((entity, d, _, _, transform)) = ds.get_mut(selected) {
+                let entity = *entity;
+                egui::CollapsingHeader::new("Transfer function")
+                    .default_open(true)
+                    .show(ui, |ui| transfer_panel(ui, d, entity, &mut state.editor));
                 egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| rendering_panel(ui, d, &mut state, &mut light));
                 egui::CollapsingHeader::new("Clipping").default_open(false).show(ui, |ui| {
                     // Planes live in the dataset's frame: the view direction taken there.
@@ -223,7 +226,7 @@ fn dataset_info(ui: &mut Ui, d: &Dataset) {
     });
 }
 
-fn transfer_panel(ui: &mut Ui, d: &mut Dataset, editor: &mut tf_editor::EditorState) {
+fn transfer_panel(ui: &mut Ui, d: &mut Dataset, entity: Entity, editor: &mut tf_editor::EditorState) {
     let hist = d.volume.stats.histogram.clone();
     let lambda = d.appearance.mode == Mode::Context;
     match &mut d.appearance.lookup {
@@ -249,14 +252,24 @@ fn transfer_panel(ui: &mut Ui, d: &mut Dataset, editor: &mut tf_editor::EditorSt
         }
         Lookup::Labels(styles) => {
             let table = d.labels.clone();
+            let picked = editor.picked_label.filter(|(e, _)| *e == entity).map(|(_, id)| id);
+            let name_of = |id: u32| table.as_ref().map(|t| t.name(id)).unwrap_or_else(|| format!("label {id}"));
+            match picked {
+                Some(id) => ui.label(RichText::new(format!("picked: {} ({id})", name_of(id))).strong()),
+                None => ui.label(RichText::new("double-click the view to pick a label").small().weak()),
+            };
             egui::ScrollArea::vertical().max_height(260.0).show(ui, |ui| {
                 for (id, s) in styles.styles.iter_mut().filter(|(id, _)| **id != 0) {
                     ui.horizontal(|ui| {
                         ui.checkbox(&mut s.visible, "");
                         ui.color_edit_button_rgb(&mut s.color);
                         ui.add(egui::Slider::new(&mut s.opacity, 0.0..=1.0).show_value(false));
-                        let name = table.as_ref().map(|t| t.name(*id)).unwrap_or_else(|| format!("label {id}"));
-                        ui.label(name);
+                        let name = name_of(*id);
+                        if picked == Some(*id) {
+                            ui.label(RichText::new(format!("▶ {name}")).strong().color(Color32::YELLOW));
+                        } else {
+                            ui.label(name);
+                        }
                     });
                 }
             });

@@ -20,6 +20,8 @@ pub struct EditorState {
     pub picking: Option<usize>,
     /// The scalar channel the curve edits.
     pub channel: Channel,
+    /// The label last picked in the viewport (dataset, label id), shown in the list.
+    pub picked_label: Option<(bevy::prelude::Entity, u32)>,
 }
 
 /// The scalar channels of a transfer function.
