@@ -78,7 +78,7 @@ pub struct Encoded {
 /// (8-bit data is moved, not copied).
 pub fn encode_samples(bytes: Vec<u8>, ty: SampleType, order: ByteOrder) -> Result<Encoded, String> {
     let size = ty.size();
-    if bytes.len() % size != 0 {
+    if !bytes.len().is_multiple_of(size) {
         return Err(format!("{} bytes is not a whole number of {} samples", bytes.len(), ty.name()));
     }
     match (ty, order) {

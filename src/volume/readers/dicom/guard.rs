@@ -197,10 +197,9 @@ impl Walker<'_> {
         let group = self.u16_at(at);
         // A nested data set starts with an even group number (not FFFE) in ascending order;
         // JPEG fragments start with FF D8, RLE with a small header count.
-        group % 2 == 0
+        group.is_multiple_of(2)
             && group != 0xFFFE
-            && group >= 0x0008
-            && group < 0x7FE1
+            && (0x0008..0x7FE1).contains(&group)
             && (!self.enc.explicit || self.bytes[at + 4].is_ascii_uppercase())
     }
 }

@@ -115,7 +115,7 @@ fn first_item(o: &InMemDicomObject, seq: Tag) -> Option<&InMemDicomObject> {
 }
 
 /// An attribute of a functional-group macro: per-frame first, then shared.
-fn group_value<'a>(o: &'a InMemDicomObject, frame: usize, macro_seq: Tag, tag: Tag) -> Option<&'a InMemElement> {
+fn group_value(o: &InMemDicomObject, frame: usize, macro_seq: Tag, tag: Tag) -> Option<&InMemElement> {
     o.get(tags::PER_FRAME_FUNCTIONAL_GROUPS_SEQUENCE)
         .and_then(|e| e.items())
         .and_then(|v| v.get(frame))
