@@ -111,13 +111,8 @@ impl FeatureJob {
 /// A feature's silhouette in one view: its signed distance field on the grid.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FeatureField {
-    pub cols: u32,
-    pub rows: u32,
-    /// Lens coordinates of the centre of cell (0, 0) (top left) and the cell size.
-    pub origin: Vec2,
-    pub cell: f32,
-    /// Aspect ratio of the screen the grid covers.
-    pub aspect: f32,
+    /// The cells (their centres and size in lens units).
+    pub grid: FeatureGrid,
     /// Signed distance to the silhouette per cell, lens units, negative inside (row
     /// major, top row first).
     pub distance: Vec<f32>,
@@ -205,14 +200,14 @@ pub fn distance_transform(seed: &[bool], cols: usize, rows: usize) -> Vec<f32> {
 impl FeatureField {
     /// The field of a mask over a screen (`cols × rows` cells covering the image); `None`
     /// when the mask is empty.
-    pub fn from_mask(mask: &[bool], grid: FeatureGrid, screen: Screen) -> Option<FeatureField> {
+    pub fn from_mask(mask: &[bool], grid: FeatureGrid) -> Option<FeatureField> {
         let (cols, rows) = (grid.cols, grid.rows);
         let (c, r) = (cols as usize, rows as usize);
         let inside = mask.iter().filter(|&&m| m).count();
         if inside == 0 {
             return None;
         }
-        let (step, origin) = (grid.step, grid.origin);
+        let step = grid.step;
         let cell = step.y;
         let to_in = distance_transform(mask, c, r);
         let outside: Vec<bool> = mask.iter().map(|m| !m).collect();
@@ -240,16 +235,7 @@ impl FeatureField {
         for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
             sum += grid.centre(i);
         }
-        Some(FeatureField {
-            cols,
-            rows,
-            origin,
-            cell: step.y,
-            aspect: screen.aspect(),
-            distance,
-            centroid: sum / inside as f32,
-            area: inside as f32 * step.x * step.y,
-        })
+        Some(FeatureField { grid, distance, centroid: sum / inside as f32, area: inside as f32 * step.x * step.y })
     }
 
     /// The header the shader reads before the distances ([`FIELD_HEADER`]).
@@ -262,24 +248,19 @@ impl FeatureField {
         (self.area / std::f32::consts::PI).sqrt()
     }
 
-    /// Horizontal cell size (lens units).
-    pub fn cell_x(&self) -> f32 {
-        2.0 * self.aspect / self.cols as f32
-    }
-
     /// Signed distance at lens coordinates `s` (bilinear between cell centres; beyond
     /// the grid, the edge value plus the distance to the edge).
     pub fn distance_at(&self, s: Vec2) -> f32 {
-        let cx = self.cell_x();
-        let gx = (s.x - self.origin.x) / cx;
-        let gy = (self.origin.y - s.y) / self.cell;
-        let (maxx, maxy) = ((self.cols - 1) as f32, (self.rows - 1) as f32);
+        let g = &self.grid;
+        let gx = (s.x - g.origin.x) / g.step.x;
+        let gy = (g.origin.y - s.y) / g.step.y;
+        let (maxx, maxy) = ((g.cols - 1) as f32, (g.rows - 1) as f32);
         let (x, y) = (gx.clamp(0.0, maxx), gy.clamp(0.0, maxy));
-        let beyond = Vec2::new((gx - x) * cx, (gy - y) * self.cell).length();
+        let beyond = Vec2::new((gx - x) * g.step.x, (gy - y) * g.step.y).length();
         let (x0, y0) = (x.floor() as usize, y.floor() as usize);
-        let (x1, y1) = ((x0 + 1).min(self.cols as usize - 1), (y0 + 1).min(self.rows as usize - 1));
+        let (x1, y1) = ((x0 + 1).min(g.cols as usize - 1), (y0 + 1).min(g.rows as usize - 1));
         let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-        let at = |x: usize, y: usize| self.distance[y * self.cols as usize + x];
+        let at = |x: usize, y: usize| self.distance[y * g.cols as usize + x];
         let top = at(x0, y0) + (at(x1, y0) - at(x0, y0)) * fx;
         let bottom = at(x0, y1) + (at(x1, y1) - at(x0, y1)) * fx;
         top + (bottom - top) * fy + beyond
@@ -372,7 +353,7 @@ mod tests {
                 (p - centre).length() < 0.4
             })
             .collect();
-        let f = FeatureField::from_mask(&mask, grid, screen).unwrap();
+        let f = FeatureField::from_mask(&mask, grid).unwrap();
         assert!((f.centroid - centre).length() < 0.01, "{}", f.centroid);
         assert!((f.equivalent_radius() - 0.4).abs() < 0.01, "{}", f.equivalent_radius());
         // Distances to the silhouette, inside and out, within a cell.
@@ -383,9 +364,9 @@ mod tests {
             let d = f.distance_at(s);
             assert!((d - want).abs() < 1.5 * cell, "{s}: {d} vs {want}");
         }
-        assert!(FeatureField::from_mask(&vec![false; mask.len()], grid, screen).is_none());
+        assert!(FeatureField::from_mask(&vec![false; mask.len()], grid).is_none());
         // A feature filling the view stays a finite field (a zoom into the feature).
-        let full = FeatureField::from_mask(&vec![true; mask.len()], grid, screen).unwrap();
+        let full = FeatureField::from_mask(&vec![true; mask.len()], grid).unwrap();
         assert!(full.distance.iter().all(|d| d.is_finite() && *d < 0.0));
         assert!(full.distance_at(Vec2::ZERO).is_finite() && full.distance_at(Vec2::new(3.0, 0.0)).is_finite());
     }

@@ -145,7 +145,7 @@ impl ResolvedLens {
     /// GPU (other lenses unchanged); `None` when the feature is not in view.
     pub fn with_silhouette(mut self, camera: &Camera, screen: Screen, scene: &RenderScene) -> Option<ResolvedLens> {
         let Some(job) = self.job.filter(|_| self.field.is_none()) else { return Some(self) };
-        let field = FeatureField::from_mask(&feature_mask(scene, &job, camera, screen), job.grid, screen)?;
+        let field = FeatureField::from_mask(&feature_mask(scene, &job, camera, screen), job.grid)?;
         self.center = field.centroid;
         self.radius = field.equivalent_radius();
         self.field = Some(Arc::new(field));

@@ -5,10 +5,10 @@
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponent;
 use bevy::render::sync_component::SyncComponent;
-use glam::{UVec4, Vec2, Vec4};
+use glam::{UVec4, Vec4};
 
 use super::gpu_types::{GpuLens, GpuSettings, lens_codes};
-use crate::lens::feature::{FIELD_HEADER, FeatureGrid, FeatureJob};
+use crate::lens::feature::{FIELD_HEADER, FeatureJob};
 use crate::lens::shape::Shape;
 use crate::lens::stack::Effect;
 use crate::lens::{MAX_LENSES, ResolvedLens, ViewLenses};
@@ -62,8 +62,7 @@ pub fn pack_lenses(settings: &mut GpuSettings, lenses: &[ResolvedLens]) {
     let mut field_offset = 0usize;
     for (i, lens) in lenses.iter().take(MAX_LENSES).enumerate() {
         let data = &mut settings.lens_data[i * lens_codes::DATA_PER_LENS..(i + 1) * lens_codes::DATA_PER_LENS];
-        let grid =
-            lens.field.as_ref().map(|f| FeatureGrid { cols: f.cols, rows: f.rows, origin: f.origin, step: Vec2::new(f.cell_x(), f.cell) });
+        let grid = lens.field.as_ref().map(|f| f.grid);
         let (shape, vertices) = match (&lens.shape, grid.or(lens.job.map(|j| j.grid))) {
             (_, Some(grid)) => {
                 data[0] = Vec4::new(grid.cols as f32, grid.rows as f32, grid.origin.x, grid.origin.y);
