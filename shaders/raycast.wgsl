@@ -136,6 +136,35 @@ fn iso_hit(r: Region, ray: Ray, tp: f32, vp: f32, t: f32, acc: vec4<f32>) -> vec
     return composite(acc, shaded(r, rgba.rgb, to_voxel(r, ray.origin + ray.dir * th), ray.dir), 1.0);
 }
 
+// The sample grid of a one-region segment: sample kk lies at t_start + (kk + j)·step on
+// the ray and at q0 + dq·(kk − k0) in the region's voxels (qd: voxels per unit t).
+struct Segment {
+    q0: vec3<f32>,
+    dq: vec3<f32>,
+    qd: vec3<f32>,
+    k0: f32,
+    t_start: f32,
+    step: f32,
+    j: f32,
+}
+
+fn segment_t(g: Segment, kk: f32) -> f32 {
+    return g.t_start + (kk + g.j) * g.step;
+}
+
+// Voxel position of sample kk; under lenses also sets the mip level for it.
+fn segment_point(g: Segment, kk: f32) -> vec3<f32> {
+#ifdef HAS_LENSES
+    update_lod(segment_t(g, kk));
+#endif
+    return g.q0 + g.dq * (kk - g.k0);
+}
+
+// Index of the first sample past the brick that holds sample kk (at q).
+fn past_brick(r: Region, g: Segment, q: vec3<f32>, kk: f32) -> f32 {
+    return max(kk + 1.0, ceil((brick_exit(r, q, g.qd, segment_t(g, kk)) - g.t_start) / g.step - g.j));
+}
+
 fn projected(mode: u32, vmax: f32, vmin: f32, vsum: f32, count: u32) -> f32 {
     if mode == MODE_MIP {
         return vmax;
@@ -265,9 +294,8 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
             // One region: a tight loop over the samples of this segment.
             let s = only;
             let r = regions[ids[s]];
-            let q0 = to_voxel(r, ray.origin + ray.dir * t);
             let qd = dir_to_voxel(r, ray.dir);
-            let dq = qd * step;
+            let g = Segment(to_voxel(r, ray.origin + ray.dir * t), qd * step, qd, k, t_start, step, j);
             var kk = k;
 #ifdef HAS_PROJECTION
             if is_projection(r.mode) {
@@ -279,17 +307,13 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                     if kk > k_end {
                         break;
                     }
-                    let q = q0 + dq * (kk - k);
-#ifdef HAS_LENSES
-                    update_lod(t_start + (kk + j) * step);
-#endif
+                    let q = segment_point(g, kk);
                     // Bricks that cannot change the running max (min) need no samples
                     // (their ranges hold for full-resolution samples only).
                     if skip && c > 0u && r.mode != MODE_X_RAY && at_full_resolution() {
                         let range = brick_range(r, q);
                         if (r.mode == MODE_MIP && range.y <= mx) || (r.mode == MODE_MIN_IP && range.x >= mn) {
-                            let tk = t_start + (kk + j) * step;
-                            kk = max(kk + 1.0, ceil((brick_exit(r, q, qd, tk) - t_start) / step - j));
+                            kk = past_brick(r, g, q, kk);
                             continue;
                         }
                     }
@@ -315,11 +339,8 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                     if kk > k_end {
                         break;
                     }
-                    let tk = t_start + (kk + j) * step;
-#ifdef HAS_LENSES
-                    update_lod(tk);
-#endif
-                    let v = trilinear(r, q0 + dq * (kk - k)) - r.iso;
+                    let tk = segment_t(g, kk);
+                    let v = trilinear(r, segment_point(g, kk)) - r.iso;
                     if has && ((vp < 0.0) != (v < 0.0)) {
                         acc = iso_hit(r, ray, tp, vp, tk, acc);
                         state[s] |= DONE;
@@ -355,25 +376,17 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                             if kk > k_end {
                                 break;
                             }
-                            let q = q0 + dq * (kk - k);
-#ifdef HAS_LENSES
-                            update_lod(t_start + (kk + j) * step);
-#endif
+                            let q = segment_point(g, kk);
                             if !at_full_resolution() || brick_occupied(r, q) {
                                 break;
                             }
-                            let tk = t_start + (kk + j) * step;
-                            kk = max(kk + 1.0, ceil((brick_exit(r, q, qd, tk) - t_start) / step - j));
+                            kk = past_brick(r, g, q, kk);
                         }
                         if kk > k_end {
                             break;
                         }
                     }
-                    let q = q0 + dq * (kk - k);
-#ifdef HAS_LENSES
-                    update_lod(t_start + (kk + j) * step);
-#endif
-                    acc = dvr_sample(r, q, ratios[s], ray, t_start + (kk + j) * step, acc);
+                    acc = dvr_sample(r, segment_point(g, kk), ratios[s], ray, segment_t(g, kk), acc);
                     kk += 1.0;
                 }
 #endif

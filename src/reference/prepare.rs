@@ -172,10 +172,6 @@ impl<'a> PreparedRegion<'a> {
 pub fn bounding_sphere(region: &Region, volume: &Volume) -> (Vec3, f32) {
     let to_world = region.world_to_voxel.inverse();
     let dims = volume.dims().as_vec3();
-    let lo = Vec3::splat(-0.5);
-    let corners =
-        (0..8).map(|i| to_world.transform_point3(lo + dims * Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32)));
-    let centre = to_world.transform_point3(lo + dims * 0.5);
-    let radius = corners.map(|c| c.distance(centre)).fold(0.0f32, f32::max);
-    (centre, radius)
+    let centre = to_world.transform_point3(dims * 0.5 - 0.5);
+    (centre, 0.5 * crate::region::longest_diagonal(Mat3::from(to_world.matrix3), dims))
 }

@@ -45,6 +45,15 @@ impl Plane {
     }
 }
 
+/// Length of the longest diagonal of a box of `dims` voxels under the linear map
+/// `voxel_to_world` (the largest of its four diagonals).
+pub fn longest_diagonal(voxel_to_world: glam::Mat3, dims: Vec3) -> f32 {
+    [Vec3::new(1.0, 1.0, 1.0), Vec3::new(1.0, -1.0, 1.0), Vec3::new(1.0, 1.0, -1.0), Vec3::new(1.0, -1.0, -1.0)]
+        .iter()
+        .map(|s| (voxel_to_world * (dims * *s)).length())
+        .fold(0.0, f32::max)
+}
+
 /// A convex region of space showing one volume through an affine map.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Region {

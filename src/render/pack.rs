@@ -9,7 +9,7 @@
 //! Packing reuses the CPU reference's preparation ([`crate::reference::prepare`]), so
 //! both renderers classify, step and shade with the same numbers. It decides nothing.
 
-use glam::{Mat3, Mat4, UVec3, Vec3, Vec4};
+use glam::{Mat3, Mat4, UVec3, Vec4};
 
 use crate::volume::pyramid::{MIP_LEVELS, half_dims};
 
@@ -203,12 +203,7 @@ pub fn march_bound(regions: &[GpuRegion]) -> u32 {
     let mut chords = 0.0f64;
     let mut step = f64::INFINITY;
     for r in regions {
-        let voxel_to_world = Mat3::from_mat4(r.world_to_voxel).inverse();
-        let d = r.dims.truncate();
-        let diagonal = [Vec3::new(1.0, 1.0, 1.0), Vec3::new(1.0, -1.0, 1.0), Vec3::new(1.0, 1.0, -1.0), Vec3::new(1.0, -1.0, -1.0)]
-            .iter()
-            .map(|s| (voxel_to_world * (d * *s)).length())
-            .fold(0.0f32, f32::max);
+        let diagonal = crate::region::longest_diagonal(Mat3::from_mat4(r.world_to_voxel).inverse(), r.dims.truncate());
         let m = Mat3::from_mat4(r.to_native);
         let frobenius = (m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared()).sqrt();
         chords += diagonal as f64;
@@ -328,6 +323,8 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
 #[cfg(test)]
 mod tests {
     use std::sync::Arc;
+
+    use glam::Vec3;
 
     use super::*;
     use crate::region::{Appearance, Plane, Region};

@@ -1,13 +1,13 @@
 //! From a scene file to volumes, appearances and cameras.
 
-use crate::clip::Clipping;
-use crate::dataset::Dataset;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Affine3A, EulerRot, Quat, Vec3};
 
 use super::file::{AppearanceSpec, CameraSpec, Change, DatasetSpec, LabelsSpec, SceneFile, SourceSpec, vec3};
+use crate::clip::Clipping;
+use crate::dataset::Dataset;
 use crate::region::{Appearance, Camera, Lookup, Orbit, Projection, Region, RenderScene, View};
 use crate::transfer::{LabelTransfer, presets};
 use crate::volume::phantom::head;
