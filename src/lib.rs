@@ -2,7 +2,7 @@
 //!
 //! The crate is organised by technique (see `../shared/DESIGN.md` and the README):
 //! [`volume`] holds the data model, readers and phantoms; [`transfer`] the transfer
-//! functions; [`region`] the geometry every renderer shares; [`lens`] the magic volume lenses; [`context`] context-preserving rendering; [`clip`] clip planes and boxes; [`reference`] the CPU
+//! functions; [`region`] the geometry every renderer shares; [`lens`] the magic volume lenses; [`context`] context-preserving rendering; [`clip`] clip planes and boxes; [`twolevel`] two-level rendering of segmented data; [`reference`] the CPU
 //! reference renderer; [`dataset`] the dataset entities that become regions; [`render`]
 //! the GPU ray caster that packs and draws them; [`scene`] scene files; [`ui`] the
 //! desktop app.
@@ -16,6 +16,7 @@ pub mod region;
 pub mod render;
 pub mod scene;
 pub mod transfer;
+pub mod twolevel;
 pub mod ui;
 pub mod volume;
 

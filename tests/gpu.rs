@@ -16,6 +16,8 @@ mod common;
 mod context;
 #[path = "gpu/lenses.rs"]
 mod lenses;
+#[path = "gpu/twolevel.rs"]
+mod twolevel;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
@@ -328,7 +330,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [(&str, fn(&mut Gpu)); 17] = [
+    let tests: [(&str, fn(&mut Gpu)); 19] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -346,6 +348,8 @@ fn main() {
         ("kappa_t_zero_is_dvr_on_the_gpu", context::kappa_t_zero_is_dvr_on_the_gpu),
         ("clipping_matches_the_reference", clip::clipping_matches_the_reference),
         ("a_clip_box_inside_the_engine_makes_minip_useful", clip::a_clip_box_inside_the_engine_makes_minip_useful),
+        ("two_level_matches_the_reference", twolevel::two_level_matches_the_reference),
+        ("overlapping_two_level_regions_match_the_reference", twolevel::overlapping_two_level_regions_match_the_reference),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

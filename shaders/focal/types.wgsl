@@ -25,14 +25,17 @@ struct Region {
     iso: f32,
     gradient_max: f32,
     mip_count: u32,
-    pad_b: f32,
-    pad_c: f32,
+    // Objects of a segmentation: the inclusive range of normalised samples they take.
+    value_lo: f32,
+    value_hi: f32,
     // Atlas offsets of mip levels 1, 2, 3 (xyz).
     mips: array<vec4<f32>, 3>,
     // Context-preserving κt, κs, power (CONTEXT_SCHLICK or CONTEXT_EXACT).
     context: vec4<f32>,
     // World bounding sphere of the volume's box (centre, radius).
     sphere: vec4<f32>,
+    // Segmented regions: first part record, part count, label record.
+    objects: vec4<u32>,
 }
 
 struct Lens {
@@ -73,6 +76,8 @@ const MODE_X_RAY: u32 = 3u;
 const MODE_GRADIENT_DVR: u32 = 4u;
 const MODE_ISO: u32 = 5u;
 const MODE_CONTEXT: u32 = 6u;
+const MODE_TWO_LEVEL: u32 = 7u;
+const MODE_OFF: u32 = 8u;
 
 const CONTEXT_SCHLICK: f32 = 0.0;
 const CONTEXT_EXACT: f32 = 1.0;

@@ -144,6 +144,7 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
             let d = ContextParams::default();
             ContextParams { kappa_t: args.kappa_t.unwrap_or(d.kappa_t), kappa_s: args.kappa_s.unwrap_or(d.kappa_s), ..d }
         },
+        segmentation: None,
     };
     let camera = match (args.azimuth, args.elevation) {
         (None, None) => CameraSpec::View { view: args.view, orthographic: args.ortho, zoom: args.zoom },

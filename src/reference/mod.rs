@@ -39,6 +39,9 @@ pub fn prepare(scene: &RenderScene) -> Result<Vec<PreparedRegion<'_>>, String> {
             let mut p = PreparedRegion::new(r, v, a);
             if !scene.skip_empty {
                 p.occupancy = None;
+                for part in p.objects.iter_mut().flat_map(|o| o.parts.iter_mut()) {
+                    part.occupancy = None;
+                }
             }
             Ok(p)
         })

@@ -1,11 +1,12 @@
 //! Everything the per-pixel function needs about one region, computed once per render:
 //! the sampler, the baked lookup, the brick occupancy and the constants of the mode.
 
-use glam::{Mat3, Vec3};
+use glam::{Affine3A, Mat3, Vec3};
 
 use crate::context::ContextParams;
 use crate::region::{Appearance, Lookup, Mode, Region, Shading};
 use crate::transfer::Lut;
+use crate::twolevel::ObjectTable;
 use crate::volume::pyramid::level_index;
 use crate::volume::sample::VolumeSampler;
 use crate::volume::{BrickGrid, Volume};
@@ -66,10 +67,55 @@ pub struct PreparedRegion<'a> {
     /// World-space bounding sphere (centre, radius) of the volume's box: the extent the
     /// context-preserving eye distance is normalised over.
     pub sphere: (Vec3, f32),
+    /// Two-level rendering: the objects of a segmented volume.
+    pub objects: Option<PreparedObjects<'a>>,
+}
+
+/// The objects of a segmented region ([`crate::twolevel`]), ready to be sampled.
+pub struct PreparedObjects<'a> {
+    pub table: ObjectTable,
+    pub labels: VolumeSampler<'a>,
+    pub label_volume: &'a Volume,
+    /// Data voxel index → label voxel index.
+    pub data_to_label: Affine3A,
+    /// One prepared region per object, then the rest (the data volume's appearance).
+    pub parts: Vec<PreparedRegion<'a>>,
+    /// Per part: whether it draws.
+    pub visible: Vec<bool>,
+}
+
+impl PreparedObjects<'_> {
+    /// The part a sample at data voxel `q` with normalised value `v` belongs to.
+    #[inline]
+    pub fn part_at(&self, q: Vec3, v: f32) -> usize {
+        let code = self.labels.nearest(self.data_to_label.transform_point3(q));
+        self.table.object(code, v).unwrap_or(self.parts.len() - 1)
+    }
 }
 
 impl<'a> PreparedRegion<'a> {
-    pub fn new(region: &'a Region, volume: &'a Volume, appearance: &Appearance) -> Self {
+    /// A region with its appearance; a segmented appearance also prepares its objects.
+    pub fn new(region: &'a Region, volume: &'a Volume, appearance: &'a Appearance) -> Self {
+        let mut p = Self::plain(region, volume, appearance);
+        if let Some(seg) = &appearance.segmentation {
+            let mut parts: Vec<PreparedRegion<'a>> = seg.objects.iter().map(|o| Self::plain(region, volume, &o.appearance)).collect();
+            parts.push(Self::plain(region, volume, appearance));
+            let mut visible: Vec<bool> = seg.objects.iter().map(|o| o.visible).collect();
+            visible.push(seg.rest_visible);
+            p.objects = Some(PreparedObjects {
+                table: seg.table(volume),
+                labels: VolumeSampler::of(&seg.labels),
+                label_volume: &seg.labels,
+                data_to_label: seg.data_to_label(&volume.grid),
+                parts,
+                visible,
+            });
+        }
+        p
+    }
+
+    /// A region with its appearance, objects left out.
+    fn plain(region: &'a Region, volume: &'a Volume, appearance: &Appearance) -> Self {
         let labels = matches!(appearance.lookup, Lookup::Labels(_));
         let lookup = match &appearance.lookup {
             Lookup::Transfer(tf) => {
@@ -101,6 +147,7 @@ impl<'a> PreparedRegion<'a> {
             occupancy,
             context: appearance.context,
             sphere: bounding_sphere(region, volume),
+            objects: None,
         }
     }
 

@@ -56,19 +56,43 @@ impl Traced {
     pub const EMPTY: Traced = Traced { color: Vec4::ZERO, value: f32::NAN, depth: f32::INFINITY, region: None, samples: 0 };
 }
 
-/// Per-region state along the ray.
+/// What a projection or iso-surface has gathered: over a region's interval, or over
+/// the current segment of a segmented region.
 #[derive(Clone, Copy)]
-struct State {
-    t0: f32,
-    t1: f32,
+struct Gathered {
     max: f32,
     min: f32,
     sum: f32,
     count: u32,
     prev: Option<(f32, f32)>,
+    /// The iso-surface was hit: nothing more to do here.
     done: bool,
+}
+
+impl Gathered {
+    const EMPTY: Gathered = Gathered { max: f32::NEG_INFINITY, min: f32::INFINITY, sum: 0.0, count: 0, prev: None, done: false };
+}
+
+/// Per-region state along the ray.
+#[derive(Clone, Copy)]
+struct State {
+    t0: f32,
+    t1: f32,
+    gathered: Gathered,
+    /// The ray has left the region (or an iso-surface ended it).
+    done: bool,
+    /// Segmented regions: the part (object, or the rest) of the current segment.
+    part: Option<usize>,
     /// Native length of one march step over the opacity reference length.
     ratio: f32,
+}
+
+/// What every sample of a ray shares.
+struct Sampling<'r> {
+    ray: &'r Ray,
+    light: Light,
+    level: f32,
+    depth_threshold: f32,
 }
 
 /// Traces one ray. `jitter` ∈ [0, 1) offsets the samples; `depth_threshold` is the
@@ -98,17 +122,7 @@ pub fn trace_antialiased(
             t_end = t_end.max(t1);
             step = step.min(r.world_step(ray.dir));
         }
-        states.push(s.map(|(t0, t1)| State {
-            t0,
-            t1,
-            max: f32::NEG_INFINITY,
-            min: f32::INFINITY,
-            sum: 0.0,
-            count: 0,
-            prev: None,
-            done: false,
-            ratio: 0.0,
-        }));
+        states.push(s.map(|(t0, t1)| State { t0, t1, gathered: Gathered::EMPTY, done: false, part: None, ratio: 0.0 }));
     }
     if !t_start.is_finite() {
         return out;
@@ -119,7 +133,6 @@ pub fn trace_antialiased(
             st.ratio = r.native_step * (step / r.world_step(ray.dir)) / r.reference_length;
         }
     }
-    let view = ray.dir;
     let stop = if stop_at_depth { depth_threshold } else { EARLY_TERMINATION };
     let mut k = 0u32;
     loop {
@@ -130,18 +143,15 @@ pub fn trace_antialiased(
         k += 1;
         out.samples = k;
         let p = ray.at(t);
-        let level = footprint.map_or(0.0, |f| f.level(t, MIP_LEVELS as f32));
+        let at = Sampling { ray: &ray, light, level: footprint.map_or(0.0, |f| f.level(t, MIP_LEVELS as f32)), depth_threshold };
         for (i, r) in regions.iter().enumerate() {
             let Some(st) = states[i].as_mut() else { continue };
             if st.done {
                 continue;
             }
             if t > st.t1 {
-                // Left this region: a projection emits its value now.
-                if r.mode.is_projection() && st.count > 0 {
-                    let v = projected(r.mode, st);
-                    emit_projection(&mut out, r, v, t, i, depth_threshold);
-                }
+                // Left this region: a projection (or the open segment) emits its value now.
+                close(&mut out, r, st, t, i, depth_threshold);
                 st.done = true;
                 continue;
             }
@@ -149,58 +159,20 @@ pub fn trace_antialiased(
                 continue;
             }
             let q = r.region.world_to_voxel.transform_point3(p);
-            match r.mode {
-                Mode::Mip | Mode::MinIp | Mode::XRay => {
-                    let v = r.sample(q, level);
-                    st.max = st.max.max(v);
-                    st.min = st.min.min(v);
-                    st.sum += v;
-                    st.count += 1;
+            match &r.objects {
+                None => {
+                    sample(&mut out, r, &mut st.gathered, st.ratio, q, t, i, &at);
+                    st.done = st.gathered.done;
                 }
-                Mode::Dvr | Mode::GradientDvr | Mode::Context => {
-                    // Occupancy holds for full-resolution samples only.
-                    if level <= 0.0 && !r.occupied(q) {
-                        continue;
+                Some(objects) => {
+                    // Two-level: a new segment starts where the object changes.
+                    let part = objects.part_at(q, r.sample(q, at.level));
+                    if st.part != Some(part) {
+                        close(&mut out, r, st, t, i, depth_threshold);
+                        st.part = Some(part);
                     }
-                    let v = r.sample(q, level);
-                    let rgba = r.lookup.classify(v, r.sampler.nearest(q));
-                    if rgba[3] <= 0.0 {
-                        continue;
-                    }
-                    let mut alpha = opacity::correct(rgba[3], st.ratio);
-                    let g = r.index_gradient_at(q, level);
-                    let gradient = (g.length() / r.gradient_max).min(1.0);
-                    let world_g = r.normal_matrix * g;
-                    if r.mode == Mode::GradientDvr {
-                        alpha *= gradient;
-                    } else if r.mode == Mode::Context {
-                        let sample = context::Sample {
-                            alpha,
-                            gradient,
-                            shading: shading_intensity(world_g, view, light, &r.shading),
-                            eye_distance: context::eye_distance(t, ray.origin, ray.dir, r.sphere.0, r.sphere.1),
-                            alpha_prev: out.color.w,
-                            lambda: r.lookup.lambda(v),
-                        };
-                        alpha = context::opacity(&r.context, &sample);
-                    }
-                    let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), world_g, view, light, &r.shading);
-                    composite(&mut out, c, alpha, t, i, depth_threshold);
-                }
-                Mode::Iso => {
-                    let v = r.sample(q, level) - r.iso;
-                    if let Some((tp, vp)) = st.prev
-                        && (vp < 0.0) != (v < 0.0)
-                    {
-                        let th = refine(r, &ray, (tp, vp), (t, v), level);
-                        let qh = r.region.world_to_voxel.transform_point3(ray.at(th));
-                        let rgba = r.lookup.classify(r.iso, r.sampler.nearest(qh));
-                        let g = r.index_gradient_at(qh, level);
-                        let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), r.normal_matrix * g, view, light, &r.shading);
-                        composite(&mut out, c, 1.0, th, i, depth_threshold);
-                        st.done = true;
-                    } else {
-                        st.prev = Some((t, v));
+                    if objects.visible[part] && !st.gathered.done {
+                        sample(&mut out, &objects.parts[part], &mut st.gathered, st.ratio, q, t, i, &at);
                     }
                 }
             }
@@ -209,21 +181,100 @@ pub fn trace_antialiased(
             break;
         }
     }
-    // Projections still open at the end of the march.
+    // Projections (and segments) still open at the end of the march.
     for (i, r) in regions.iter().enumerate() {
-        if let Some(st) = states[i]
+        if let Some(st) = states[i].as_mut()
             && !st.done
-            && r.mode.is_projection()
-            && st.count > 0
             && out.color.w < stop
         {
-            emit_projection(&mut out, r, projected(r.mode, &st), st.t1, i, depth_threshold);
+            close(&mut out, r, st, st.t1, i, depth_threshold);
         }
     }
     out
 }
 
-fn projected(mode: Mode, st: &State) -> f32 {
+/// One sample of region `r` (or of one part of a segmented region) at voxel position
+/// `q`, ray parameter `t`: composited at once (DVR modes), gathered (projections) or
+/// tested for a crossing (iso-surfaces).
+#[allow(clippy::too_many_arguments)]
+fn sample(out: &mut Traced, r: &PreparedRegion, g: &mut Gathered, ratio: f32, q: Vec3, t: f32, i: usize, at: &Sampling) {
+    let (ray, light, level, depth_threshold) = (at.ray, at.light, at.level, at.depth_threshold);
+    let view = ray.dir;
+    match r.mode {
+        Mode::Mip | Mode::MinIp | Mode::XRay => {
+            let v = r.sample(q, level);
+            g.max = g.max.max(v);
+            g.min = g.min.min(v);
+            g.sum += v;
+            g.count += 1;
+        }
+        Mode::Dvr | Mode::GradientDvr | Mode::Context => {
+            // Occupancy holds for full-resolution samples only.
+            if level <= 0.0 && !r.occupied(q) {
+                return;
+            }
+            let v = r.sample(q, level);
+            let rgba = r.lookup.classify(v, r.sampler.nearest(q));
+            if rgba[3] <= 0.0 {
+                return;
+            }
+            let mut alpha = opacity::correct(rgba[3], ratio);
+            let grad = r.index_gradient_at(q, level);
+            let gradient = (grad.length() / r.gradient_max).min(1.0);
+            let world_g = r.normal_matrix * grad;
+            if r.mode == Mode::GradientDvr {
+                alpha *= gradient;
+            } else if r.mode == Mode::Context {
+                let sample = context::Sample {
+                    alpha,
+                    gradient,
+                    shading: shading_intensity(world_g, view, light, &r.shading),
+                    eye_distance: context::eye_distance(t, ray.origin, ray.dir, r.sphere.0, r.sphere.1),
+                    alpha_prev: out.color.w,
+                    lambda: r.lookup.lambda(v),
+                };
+                alpha = context::opacity(&r.context, &sample);
+            }
+            let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), world_g, view, light, &r.shading);
+            composite(out, c, alpha, t, i, depth_threshold);
+        }
+        Mode::Iso => {
+            let v = r.sample(q, level) - r.iso;
+            if let Some((tp, vp)) = g.prev
+                && (vp < 0.0) != (v < 0.0)
+            {
+                let th = refine(r, ray, (tp, vp), (t, v), level);
+                let qh = r.region.world_to_voxel.transform_point3(ray.at(th));
+                let rgba = r.lookup.classify(r.iso, r.sampler.nearest(qh));
+                let grad = r.index_gradient_at(qh, level);
+                let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), r.normal_matrix * grad, view, light, &r.shading);
+                composite(out, c, 1.0, th, i, depth_threshold);
+                g.done = true;
+            } else {
+                g.prev = Some((t, v));
+            }
+        }
+    }
+}
+
+/// Ends what region `r` has gathered at ray parameter `t` (leaving the region, or its
+/// segment ending): a projection emits its value as one sample; then it starts afresh.
+fn close(out: &mut Traced, r: &PreparedRegion, st: &mut State, t: f32, i: usize, threshold: f32) {
+    let part = match (&r.objects, st.part) {
+        (None, _) => Some(r),
+        (Some(objects), Some(k)) if objects.visible[k] => Some(&objects.parts[k]),
+        _ => None,
+    };
+    if let Some(part) = part
+        && part.mode.is_projection()
+        && st.gathered.count > 0
+    {
+        emit_projection(out, part, projected(part.mode, &st.gathered), t, i, threshold);
+    }
+    st.gathered = Gathered::EMPTY;
+}
+
+fn projected(mode: Mode, st: &Gathered) -> f32 {
     match mode {
         Mode::Mip => st.max,
         Mode::MinIp => st.min,

@@ -7,6 +7,7 @@ use glam::Vec3;
 
 use crate::context::ContextParams;
 use crate::transfer::{LabelTransfer, Lut, TransferFunction};
+use crate::twolevel::Segmentation;
 use crate::volume::Volume;
 
 /// Rendering modes.
@@ -112,6 +113,9 @@ pub struct Appearance {
     pub iso_value: f64,
     /// κt, κs of [`Mode::Context`].
     pub context: ContextParams,
+    /// Two-level rendering ([`crate::twolevel`]): a label volume splits the data into
+    /// objects with their own modes; this appearance then draws the rest.
+    pub segmentation: Option<Segmentation>,
 }
 
 impl Appearance {
@@ -123,6 +127,7 @@ impl Appearance {
             step: 0.5,
             iso_value: 0.0,
             context: ContextParams::default(),
+            segmentation: None,
         }
     }
 
@@ -131,6 +136,10 @@ impl Appearance {
     /// range maps only to zero opacity adds nothing. `None` for modes that look at every
     /// sample (projections, iso-surfaces).
     pub fn brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {
+        // Segmented volumes: every sample decides which object a segment belongs to.
+        if self.segmentation.is_some() {
+            return None;
+        }
         let bricks = volume.bricks();
         match &self.lookup {
             Lookup::Transfer(tf) if matches!(self.mode, Mode::Dvr | Mode::GradientDvr | Mode::Context) => {

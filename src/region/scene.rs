@@ -64,6 +64,18 @@ impl RenderScene {
 }
 
 impl RenderScene {
+    /// Every volume the scene samples: its volumes, then the label volumes of
+    /// segmentations that are not among them (the GPU atlas holds all of these).
+    pub fn all_volumes(&self) -> Vec<Arc<Volume>> {
+        let mut all = self.volumes.clone();
+        for seg in self.appearances.iter().filter_map(|a| a.segmentation.as_ref()) {
+            if !all.iter().any(|v| Arc::ptr_eq(v, &seg.labels)) {
+                all.push(seg.labels.clone());
+            }
+        }
+        all
+    }
+
     /// Bounding sphere (centre, radius) of the volumes the regions show; a unit sphere
     /// at the origin for an empty scene.
     pub fn bounding_sphere(&self) -> (glam::Vec3, f32) {

@@ -16,6 +16,10 @@ pub mod mode {
     pub const GRADIENT_DVR: u32 = 4;
     pub const ISO: u32 = 5;
     pub const CONTEXT: u32 = 6;
+    /// A segmented region: each sample's object has its own mode (`objects`).
+    pub const TWO_LEVEL: u32 = 7;
+    /// Draws nothing (hidden objects, the label record of a segmentation).
+    pub const OFF: u32 = 8;
 }
 
 /// How a region evaluates the outer power of context-preserving opacity.
@@ -49,9 +53,11 @@ pub mod features {
     pub const LENSES: u32 = 128;
     /// Context-preserving DVR.
     pub const CONTEXT: u32 = 256;
+    /// Two-level rendering of segmented volumes.
+    pub const TWO_LEVEL: u32 = 512;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 9] = [
+    pub const NAMES: [(u32, &str); 10] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -61,6 +67,7 @@ pub mod features {
         (MULTI_REGION, "MULTI_REGION"),
         (LENSES, "HAS_LENSES"),
         (CONTEXT, "HAS_CONTEXT"),
+        (TWO_LEVEL, "HAS_TWO_LEVEL"),
     ];
 }
 
@@ -108,14 +115,19 @@ pub struct GpuRegion {
     pub gradient_max: f32,
     /// Mip levels above the volume in the atlas (0 when the atlas has no room for them).
     pub mip_count: u32,
-    pub pad_b: f32,
-    pub pad_c: f32,
+    /// Objects of a segmentation: the inclusive range of normalised samples they take.
+    pub value_lo: f32,
+    pub value_hi: f32,
     /// Atlas texel offsets of mip levels 1… (xyz).
     pub mips: [Vec4; MIP_LEVELS],
     /// Context-preserving κt, κs, power ([`context_power`]).
     pub context: Vec4,
     /// World bounding sphere of the volume's box (centre, radius).
     pub sphere: Vec4,
+    /// Segmented regions ([`mode::TWO_LEVEL`]): index of the first part record (the
+    /// objects, then the rest), the number of parts, and the index of the label
+    /// record (the label volume with, per code, up to four candidate objects + 1).
+    pub objects: UVec4,
 }
 
 /// Lens kinds, shapes (codes shared with `shaders/focal/lens.wgsl`).

@@ -9,7 +9,7 @@
 //! Packing reuses the CPU reference's preparation ([`crate::reference::prepare`]), so
 //! both renderers classify, step and shade with the same numbers. It decides nothing.
 
-use glam::{Mat3, Mat4, UVec3, Vec4};
+use glam::{Mat3, Mat4, UVec3, UVec4, Vec4};
 
 use crate::volume::pyramid::{MIP_LEVELS, half_dims};
 
@@ -46,6 +46,9 @@ pub struct PackedScene {
     pub dropped: Vec<String>,
     /// Index in `regions` of every scene region (`None` for those dropped).
     pub region_slots: Vec<Option<u32>>,
+    /// Regions the ray traverses: the first `region_count` of `regions` (the others
+    /// are records of segmentations).
+    pub region_count: u32,
     /// Shader features the regions need ([`super::gpu_types::features`]).
     pub features: u32,
     /// Bound on the iterations of the ray caster's loops ([`march_bound`]).
@@ -122,16 +125,33 @@ fn mode_number(m: Mode) -> u32 {
 /// Packs `scene` with atlases of at most `max_texture` texels per axis.
 pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String> {
     let prepared = crate::reference::prepare(scene)?;
+    let all = scene.all_volumes();
+    let index_of = |v: &std::sync::Arc<crate::volume::Volume>| all.iter().position(|a| std::sync::Arc::ptr_eq(a, v));
+    // The volumes each region samples: its own, and a segmentation's label volume.
+    let uses: Vec<Vec<usize>> = prepared
+        .iter()
+        .map(|p| {
+            let mut u = vec![p.region.volume];
+            if let Some(seg) = scene.appearances.get(p.region.appearance).and_then(|a| a.segmentation.as_ref()) {
+                u.extend(index_of(&seg.labels));
+            }
+            u
+        })
+        .collect();
     let mut out = PackedScene::default();
     // Volumes in order of first use; those that no longer fit are dropped.
-    for p in &prepared {
-        if out.volumes.contains(&p.region.volume) {
+    for (p, used) in prepared.iter().zip(&uses) {
+        let mut candidate = out.volumes.clone();
+        for &v in used {
+            if !candidate.contains(&v) {
+                candidate.push(v);
+            }
+        }
+        if candidate.len() == out.volumes.len() {
             continue;
         }
-        let mut candidate = out.volumes.clone();
-        candidate.push(p.region.volume);
-        let boxes = |mips: bool| -> Vec<UVec3> { candidate.iter().flat_map(|&v| volume_boxes(scene.volumes[v].dims(), mips)).collect() };
-        let bricks: Vec<UVec3> = candidate.iter().map(|&v| scene.volumes[v].bricks().dims).collect();
+        let boxes = |mips: bool| -> Vec<UVec3> { candidate.iter().flat_map(|&v| volume_boxes(all[v].dims(), mips)).collect() };
+        let bricks: Vec<UVec3> = candidate.iter().map(|&v| all[v].bricks().dims).collect();
         // Mip chains only while every volume's chain fits; volumes come first.
         let with_mips = if out.mips || out.volumes.is_empty() { atlas_layout(&boxes(true), max_texture) } else { None };
         let layout = with_mips.map(|a| (a, true)).or_else(|| atlas_layout(&boxes(false), max_texture).map(|a| (a, false)));
@@ -149,22 +169,36 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
     }
     let mut next = 0;
     for &v in &out.volumes {
-        let count = volume_boxes(scene.volumes[v].dims(), out.mips).len();
+        let count = volume_boxes(all[v].dims(), out.mips).len();
         out.levels.push(out.atlas.offsets[next..next + count].to_vec());
         next += count;
     }
-    for p in &prepared {
-        let Some(slot) = out.volumes.iter().position(|&v| v == p.region.volume) else {
+    let slot_of = |out: &PackedScene, v: usize| out.volumes.iter().position(|&u| u == v);
+    let mut segmented = Vec::new();
+    for (p, used) in prepared.iter().zip(&uses) {
+        let slots: Option<Vec<usize>> = used.iter().map(|&v| slot_of(&out, v)).collect();
+        let Some(slots) = slots else {
             out.region_slots.push(None);
             continue;
         };
         out.region_slots.push(Some(out.regions.len() as u32));
-        let levels = out.levels[slot].clone();
-        let region = pack_region(p, &levels, out.brick_atlas.offsets[slot], &mut out);
+        let levels = out.levels[slots[0]].clone();
+        let mut region = pack_region(p, &levels, out.brick_atlas.offsets[slots[0]], &mut out);
+        if p.objects.is_some() {
+            region.mode = mode::TWO_LEVEL;
+            region.flags &= !region_flags::OCCUPANCY;
+            segmented.push((out.regions.len(), p, slots));
+        }
         out.regions.push(region);
     }
+    out.region_count = out.regions.len() as u32;
+    // Records the ray does not traverse: the parts and labels of segmented regions.
+    for (index, p, slots) in segmented {
+        let objects = pack_objects(p, &slots, &mut out);
+        out.regions[index].objects = objects;
+    }
     out.features = scene_features(&out.regions);
-    out.max_steps = march_bound(&out.regions);
+    out.max_steps = march_bound(&out.regions[..out.region_count as usize]);
     // Empty scenes still bind (1-texel) atlases.
     out.atlas.size = out.atlas.size.max(UVec3::ONE);
     out.brick_atlas.size = out.brick_atlas.size.max(UVec3::ONE);
@@ -180,6 +214,41 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.planes.push(Vec4::ZERO);
     }
     Ok(out)
+}
+
+/// Appends the part records of a segmented region (each object, then the rest: the
+/// data volume with that part's appearance and value range) and its label record (the
+/// label volume, mapped from world space, with the object table as its lookup).
+/// Returns the region's `objects` field. `slots`: the data volume's, the labels'.
+fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> UVec4 {
+    let Some(objects) = &p.objects else { return UVec4::ZERO };
+    let first = out.regions.len() as u32;
+    let data_levels = out.levels[slots[0]].clone();
+    for (k, part) in objects.parts.iter().enumerate() {
+        let mut r = pack_region(part, &data_levels, out.brick_atlas.offsets[slots[0]], out);
+        (r.value_lo, r.value_hi) = objects.table.ranges.get(k).copied().unwrap_or((f32::NEG_INFINITY, f32::INFINITY));
+        // Infinities do not survive every path to the GPU: the largest finite floats.
+        (r.value_lo, r.value_hi) = (r.value_lo.max(f32::MIN), r.value_hi.min(f32::MAX));
+        if !objects.visible[k] {
+            r.mode = mode::OFF;
+        }
+        out.regions.push(r);
+    }
+    let label_slot = slots.get(1).copied().unwrap_or(slots[0]);
+    let labels = objects.label_volume;
+    let lut_offset = out.lut.len() as u32;
+    out.lut.extend(objects.table.candidates.iter().map(|c| c.map(|k| k as f32)));
+    let world_to_labels = objects.data_to_label * p.region.world_to_voxel;
+    out.regions.push(GpuRegion {
+        world_to_voxel: Mat4::from(world_to_labels),
+        dims: labels.dims().as_vec3().extend(labels.code_max() as f32),
+        atlas_offset: out.levels[label_slot][0].as_vec3().extend(0.0),
+        mode: mode::OFF,
+        lut_offset,
+        lut_width: objects.table.candidates.len() as u32,
+        ..Default::default()
+    });
+    UVec4::new(first, objects.parts.len() as u32, out.regions.len() as u32 - 1, 0)
 }
 
 /// Most iterations any loop of the ray caster can make on one ray through `regions`:
@@ -223,6 +292,8 @@ pub fn scene_features(regions: &[GpuRegion]) -> u32 {
     for r in regions {
         let labels = r.flags & region_flags::LABELS != 0;
         bits |= match r.mode {
+            mode::OFF => 0,
+            mode::TWO_LEVEL => f::TWO_LEVEL,
             mode::MIP | mode::MIN_IP | mode::X_RAY if !labels => f::PROJECTION,
             mode::ISO if !labels => f::ISO,
             mode::GRADIENT_DVR if !labels => f::DVR | f::GRADIENT_MODULATION,
@@ -304,8 +375,8 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
         iso: p.iso,
         gradient_max: p.gradient_max,
         mip_count: levels.len() as u32 - 1,
-        pad_b: 0.0,
-        pad_c: 0.0,
+        value_lo: 0.0,
+        value_hi: 0.0,
         mips: std::array::from_fn(|k| levels.get(k + 1).map_or(Vec4::ZERO, |o| o.as_vec3().extend(1.0))),
         context: Vec4::new(
             p.context.kappa_t,
@@ -317,6 +388,7 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
             0.0,
         ),
         sphere: p.sphere.0.extend(p.sphere.1),
+        objects: UVec4::ZERO,
     }
 }
 

@@ -89,14 +89,15 @@ pub fn upload_scene(
             "no room for the volumes' mip chains in one texture atlas: lenses sample full resolution where they compress (the CPU reference does not)"
         );
     }
-    let key: Vec<usize> = packed.volumes.iter().map(|&v| Arc::as_ptr(&scene.volumes[v]) as usize).collect();
+    let all = scene.all_volumes();
+    let key: Vec<usize> = packed.volumes.iter().map(|&v| Arc::as_ptr(&all[v]) as usize).collect();
     if gpu.atlas_key != key || gpu.atlases.is_none() {
-        let volumes: Vec<&Volume> = packed.volumes.iter().map(|&v| scene.volumes[v].as_ref()).collect();
+        let volumes: Vec<&Volume> = packed.volumes.iter().map(|&v| all[v].as_ref()).collect();
         gpu.atlases = Some(atlases(&device, &queue, &volumes, &packed, sixteen_bit_format(&adapter)));
         gpu.atlas_key = key;
     }
     write_buffers(&device, &queue, &packed, &mut gpu);
-    gpu.region_count = packed.regions.len() as u32;
+    gpu.region_count = packed.region_count;
     gpu.features = packed.features;
     gpu.dropped = packed.dropped;
     gpu.region_slots = packed.region_slots;
@@ -223,7 +224,7 @@ fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScen
     let inv = 1.0 / packed.atlas.size.max(UVec3::ONE).as_vec3();
     let info = GpuSceneInfo {
         inv_atlas_size: inv.extend(0.0),
-        region_count: packed.regions.len() as u32,
+        region_count: packed.region_count,
         lut_atlas_width: LUT_ATLAS_WIDTH,
         max_steps: packed.max_steps,
         pad_b: 0,

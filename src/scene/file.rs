@@ -35,10 +35,6 @@ fn default_size() -> (u32, u32) {
     (512, 512)
 }
 
-fn yes() -> bool {
-    true
-}
-
 fn default_step() -> f32 {
     0.5
 }
@@ -185,6 +181,49 @@ pub struct AppearanceSpec {
     /// κt, κs of the context-preserving mode.
     #[serde(default)]
     pub context: ContextParams,
+    /// Two-level rendering: objects from a label dataset, each with its own appearance;
+    /// this appearance draws the rest.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub segmentation: Option<SegmentationSpec>,
+}
+
+/// The objects of a segmented dataset ([`crate::twolevel`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SegmentationSpec {
+    /// Index in `datasets` of the label volume (it may be hidden; its grid places it).
+    pub labels: usize,
+    /// In order: a sample belongs to the first object that takes it.
+    pub objects: Vec<ObjectSpec>,
+    /// Whether samples in no object are drawn.
+    #[serde(default = "yes")]
+    pub rest_visible: bool,
+}
+
+/// One object of a segmentation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectSpec {
+    pub name: String,
+    /// Label codes it takes.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub labels: Vec<u32>,
+    /// Label names from the label dataset's table (a trailing `*` matches every name
+    /// with that prefix). With neither codes nor names the object takes every label.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub names: Vec<String>,
+    /// Range of data values (real units, inclusive) it takes.
+    #[serde(default)]
+    pub values: Option<(f64, f64)>,
+    #[serde(default = "yes")]
+    pub visible: bool,
+    /// Mode, transfer function, shading, iso-value, context parameters.
+    #[serde(default)]
+    pub appearance: AppearanceSpec,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Default for AppearanceSpec {
@@ -198,6 +237,7 @@ impl Default for AppearanceSpec {
             step: 0.5,
             iso: None,
             context: ContextParams::default(),
+            segmentation: None,
         }
     }
 }
@@ -345,6 +385,15 @@ pub enum Change {
         dataset: usize,
         label: u32,
         opacity: f32,
+    },
+    /// One object of a segmented dataset (by index in its `objects`).
+    Object {
+        dataset: usize,
+        object: usize,
+        #[serde(default)]
+        mode: Option<Mode>,
+        #[serde(default)]
+        visible: Option<bool>,
     },
     Background((f32, f32, f32)),
     Light(Light),

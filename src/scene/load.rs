@@ -5,11 +5,12 @@ use std::sync::Arc;
 
 use glam::{Affine3A, EulerRot, Quat, Vec3};
 
-use super::file::{AppearanceSpec, CameraSpec, Change, DatasetSpec, LabelsSpec, SceneFile, SourceSpec, vec3};
+use super::file::{AppearanceSpec, CameraSpec, Change, DatasetSpec, LabelsSpec, SceneFile, SegmentationSpec, SourceSpec, vec3};
 use crate::clip::Clipping;
 use crate::dataset::Dataset;
 use crate::region::{Appearance, Camera, Lookup, Orbit, Projection, Region, RenderScene, View};
 use crate::transfer::{LabelTransfer, presets};
+use crate::twolevel::{Object, Segmentation};
 use crate::volume::phantom::head;
 use crate::volume::readers::{Progress, RawSpec, ReadOptions, label_table, read_volume};
 use crate::volume::{LabelTable, LabelVolume, Volume};
@@ -62,7 +63,69 @@ pub fn load_datasets(scene: &SceneFile, base: &Path) -> Result<Vec<LoadedDataset
 /// Like [`load_datasets`], reporting the bytes read to `progress`.
 pub fn load_datasets_with(scene: &SceneFile, base: &Path, progress: Option<Progress>) -> Result<Vec<LoadedDataset>, String> {
     let options = ReadOptions { progress, ..Default::default() };
-    scene.datasets.iter().enumerate().map(|(i, d)| load_dataset(d, base, &options).map_err(|e| format!("dataset {i}: {e}"))).collect()
+    let mut datasets: Vec<LoadedDataset> = scene
+        .datasets
+        .iter()
+        .enumerate()
+        .map(|(i, d)| load_dataset(d, base, &options).map_err(|e| format!("dataset {i}: {e}")))
+        .collect::<Result<_, _>>()?;
+    // Segmentations refer to other datasets: resolved once all are loaded.
+    for i in 0..datasets.len() {
+        if let Some(spec) = &scene.datasets[i].appearance.segmentation {
+            let seg = segmentation(spec, &datasets, &datasets[i].volume, base).map_err(|e| format!("dataset {i}: segmentation: {e}"))?;
+            datasets[i].appearance.segmentation = Some(seg);
+        }
+    }
+    Ok(datasets)
+}
+
+/// The segmentation a spec describes for data volume `data`.
+pub fn segmentation(spec: &SegmentationSpec, datasets: &[LoadedDataset], data: &Volume, base: &Path) -> Result<Segmentation, String> {
+    let n = datasets.len();
+    let source = datasets.get(spec.labels).ok_or_else(|| format!("labels refers to dataset {}, the scene has {n}", spec.labels))?;
+    let objects = spec
+        .objects
+        .iter()
+        .map(|o| {
+            let mut labels = o.labels.clone();
+            for pattern in &o.names {
+                let found = matching_labels(pattern, source.table.as_ref());
+                if found.is_empty() {
+                    return Err(format!("object '{}': no label of '{}' is named '{pattern}'", o.name, source.name));
+                }
+                labels.extend(found);
+            }
+            labels.sort_unstable();
+            labels.dedup();
+            if o.appearance.segmentation.is_some() {
+                return Err(format!("object '{}': an object cannot be segmented again", o.name));
+            }
+            Ok(Object {
+                name: o.name.clone(),
+                labels,
+                values: o.values,
+                visible: o.visible,
+                appearance: appearance(&o.appearance, data, None, base).map_err(|e| format!("object '{}': {e}", o.name))?,
+            })
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let seg = Segmentation { labels: source.volume.clone(), objects, rest_visible: spec.rest_visible };
+    seg.validate()?;
+    Ok(seg)
+}
+
+/// Ids of the labels named `pattern` (a trailing `*` matches a prefix; case-insensitive).
+pub fn matching_labels(pattern: &str, table: Option<&LabelTable>) -> Vec<u32> {
+    let Some(table) = table else { return Vec::new() };
+    let p = pattern.to_ascii_lowercase();
+    let matches = |name: &str| {
+        let name = name.to_ascii_lowercase();
+        match p.strip_suffix('*') {
+            Some(prefix) => name.starts_with(prefix),
+            None => name == p,
+        }
+    };
+    table.labels.iter().filter(|(_, l)| matches(&l.name)).map(|(id, _)| *id).collect()
 }
 
 fn load_dataset(spec: &DatasetSpec, base: &Path, options: &ReadOptions) -> Result<LoadedDataset, String> {
@@ -157,6 +220,7 @@ pub fn appearance(spec: &AppearanceSpec, volume: &Volume, table: Option<&LabelTa
         step: spec.step,
         iso_value: spec.iso.unwrap_or((volume.stats.min + volume.stats.max) * 0.5),
         context: spec.context.validated()?,
+        segmentation: None,
     })
 }
 
@@ -245,6 +309,19 @@ pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneF
             }
             Lookup::Transfer(_) => return Err(format!("dataset {dataset} is not shown as labels")),
         },
+        Change::Object { dataset, object, mode, visible } => {
+            let seg =
+                datasets[get(*dataset)?].appearance.segmentation.as_mut().ok_or_else(|| format!("dataset {dataset} is not segmented"))?;
+            let count = seg.objects.len();
+            let o =
+                seg.objects.get_mut(*object).ok_or_else(|| format!("change refers to object {object}, dataset {dataset} has {count}"))?;
+            if let Some(m) = mode {
+                o.appearance.mode = *m;
+            }
+            if let Some(v) = visible {
+                o.visible = *v;
+            }
+        }
         Change::Background(c) => scene.background = *c,
         Change::Light(l) => scene.light = *l,
         Change::Lenses(l) => scene.lenses = l.clone(),

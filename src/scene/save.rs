@@ -7,9 +7,12 @@ use std::path::Path;
 
 use glam::{EulerRot, Quat, Vec3};
 
-use super::file::{AppearanceSpec, CameraSpec, DatasetSpec, LabelOverride, LabelsSpec, SceneFile, SourceSpec};
+use super::file::{
+    AppearanceSpec, CameraSpec, DatasetSpec, LabelOverride, LabelsSpec, ObjectSpec, SceneFile, SegmentationSpec, SourceSpec,
+};
 use super::load::resolve;
 use crate::region::{Appearance, Camera, Light, Lookup, Projection};
+use crate::twolevel::Segmentation;
 
 /// One dataset as the app holds it.
 pub struct DatasetState<'a> {
@@ -53,7 +56,26 @@ pub fn appearance_spec(a: &Appearance, labels_table: Option<&LabelsSpec>) -> App
         step: a.step,
         iso: Some(a.iso_value),
         context: a.context,
+        segmentation: None,
     }
+}
+
+/// A segmentation as a spec (objects by label code); `labels` is the label dataset's
+/// index.
+pub fn segmentation_spec(seg: &Segmentation, labels: usize) -> SegmentationSpec {
+    let objects = seg
+        .objects
+        .iter()
+        .map(|o| ObjectSpec {
+            name: o.name.clone(),
+            labels: o.labels.clone(),
+            names: Vec::new(),
+            values: o.values,
+            visible: o.visible,
+            appearance: appearance_spec(&o.appearance, None),
+        })
+        .collect();
+    SegmentationSpec { labels, objects, rest_visible: seg.rest_visible }
 }
 
 /// Source paths made absolute (the saved file may live elsewhere).
@@ -83,7 +105,15 @@ pub fn scene_file(
             DatasetSpec {
                 name: d.spec.name.clone(),
                 source: absolute(&d.spec.source, base),
-                appearance: appearance_spec(d.appearance, d.spec.appearance.labels.as_ref()),
+                appearance: AppearanceSpec {
+                    segmentation: d
+                        .appearance
+                        .segmentation
+                        .as_ref()
+                        .zip(d.spec.appearance.segmentation.as_ref())
+                        .map(|(seg, spec)| segmentation_spec(seg, spec.labels)),
+                    ..appearance_spec(d.appearance, d.spec.appearance.labels.as_ref())
+                },
                 translation: d.translation.into(),
                 rotation_deg: (x.to_degrees(), y.to_degrees(), z.to_degrees()),
                 visible: d.visible,

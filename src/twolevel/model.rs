@@ -1,0 +1,234 @@
+//! Objects of a segmented volume and the per-sample object lookup.
+//!
+//! A sample belongs to the first object (in list order) that lists its label code — an
+//! object with no codes takes every code — and whose value range, if it has one,
+//! contains the sample's data value; a sample in no object belongs to the rest. So one
+//! label can be split by value (the AAL atlas's background 0 holds scalp, skull and
+//! white matter alike; "label 0 with a bright T1 value" picks the scalp and marrow), and
+//! a value range alone makes objects of data without labels.
+//!
+//! Both renderers look objects up in an [`ObjectTable`]: per label code, the first
+//! [`MAX_CANDIDATES`] objects that list it, tried in order against their value ranges.
+
+use std::sync::Arc;
+
+use glam::Affine3A;
+
+use crate::region::{Appearance, Lookup, Mode};
+use crate::volume::{Grid, Volume};
+
+/// Most objects of one segmentation (the shader keeps one region record per object).
+pub const MAX_OBJECTS: usize = 64;
+/// Most objects that may list one label code (one RGBA texel of candidates per code).
+pub const MAX_CANDIDATES: usize = 4;
+
+/// A data volume's split into objects by a label volume.
+#[derive(Clone, Debug)]
+pub struct Segmentation {
+    /// The label volume. It is placed by its grid in the data volume's frame (both
+    /// grids' world coordinates are the same scanner space), so it follows the data
+    /// volume wherever a region shows it.
+    pub labels: Arc<Volume>,
+    pub objects: Vec<Object>,
+    /// Whether samples in no object are drawn (with the data volume's own appearance).
+    pub rest_visible: bool,
+}
+
+/// Equal when they use the same label volume (the same shared data) the same way.
+impl PartialEq for Segmentation {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.labels, &other.labels) && self.objects == other.objects && self.rest_visible == other.rest_visible
+    }
+}
+
+/// One object: which samples it takes and how its segments are rendered.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    pub name: String,
+    /// Label codes it takes (empty: every code).
+    pub labels: Vec<u32>,
+    /// Range of data values (real units, inclusive) it takes; `None`: any value.
+    pub values: Option<(f64, f64)>,
+    /// Hidden objects keep their samples (they do not fall to the rest) but draw nothing.
+    pub visible: bool,
+    /// Mode, transfer function, shading, iso-value and context parameters of its
+    /// segments (the sample step is the data volume's).
+    pub appearance: Appearance,
+}
+
+impl Object {
+    /// An object of `labels` rendered with `appearance`.
+    pub fn new(name: impl Into<String>, labels: Vec<u32>, appearance: Appearance) -> Object {
+        Object { name: name.into(), labels, values: None, visible: true, appearance }
+    }
+
+    /// Whether the object lists `code`.
+    pub fn takes_code(&self, code: u32) -> bool {
+        self.labels.is_empty() || self.labels.contains(&code)
+    }
+}
+
+impl Segmentation {
+    /// Checks what the renderers rely on; errors name the object.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.objects.len() > MAX_OBJECTS {
+            return Err(format!("{} objects: at most {MAX_OBJECTS} per segmentation", self.objects.len()));
+        }
+        for o in &self.objects {
+            if !matches!(o.appearance.lookup, Lookup::Transfer(_)) {
+                return Err(format!("object '{}': needs a transfer function (label colours are for label volumes)", o.name));
+            }
+            if o.appearance.segmentation.is_some() {
+                return Err(format!("object '{}': an object cannot be segmented again", o.name));
+            }
+            if let Some((lo, hi)) = o.values
+                && !(lo.is_finite() && hi.is_finite() && lo <= hi)
+            {
+                return Err(format!("object '{}': value range ({lo}, {hi}) is not a finite range with low ≤ high", o.name));
+            }
+        }
+        let codes = self.labels.stats.code_max as u32;
+        for code in 0..=codes {
+            let n = self.objects.iter().filter(|o| o.takes_code(code)).count();
+            if n > MAX_CANDIDATES {
+                return Err(format!("label {code} is listed by {n} objects: at most {MAX_CANDIDATES} objects may share a label"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Map from the data volume's voxel index to the label volume's.
+    pub fn data_to_label(&self, data: &Grid) -> Affine3A {
+        self.labels.grid.world_to_index() * data.index_to_world()
+    }
+
+    /// The lookup table both renderers use, for data volume `data`.
+    pub fn table(&self, data: &Volume) -> ObjectTable {
+        let codes = self.labels.stats.code_max as usize + 1;
+        let candidates = (0..codes)
+            .map(|code| {
+                let mut c = [0u16; MAX_CANDIDATES];
+                let listed = self.objects.iter().enumerate().filter(|(_, o)| o.takes_code(code as u32));
+                for (slot, (i, _)) in c.iter_mut().zip(listed) {
+                    *slot = i as u16 + 1;
+                }
+                c
+            })
+            .collect();
+        let ranges = self
+            .objects
+            .iter()
+            .map(|o| match o.values {
+                Some((lo, hi)) => (data.real_to_normalized(lo) as f32, data.real_to_normalized(hi) as f32),
+                None => (f32::NEG_INFINITY, f32::INFINITY),
+            })
+            .collect();
+        ObjectTable { candidates, ranges }
+    }
+
+    /// The modes the objects draw with (for the shader's feature list).
+    pub fn modes(&self) -> impl Iterator<Item = Mode> + '_ {
+        self.objects.iter().filter(|o| o.visible).map(|o| o.appearance.mode)
+    }
+}
+
+/// Per label code, the objects that list it; per object, its normalised value range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectTable {
+    /// Object index + 1 of up to [`MAX_CANDIDATES`] objects per code, in list order
+    /// (0: no more).
+    pub candidates: Vec<[u16; MAX_CANDIDATES]>,
+    /// Inclusive range of normalised samples per object (infinite without a range).
+    pub ranges: Vec<(f32, f32)>,
+}
+
+impl ObjectTable {
+    /// The object of a sample with label `code` and normalised data value `v`
+    /// (`None`: the rest).
+    pub fn object(&self, code: u16, v: f32) -> Option<usize> {
+        let c = self.candidates.get(code as usize)?;
+        c.iter().take_while(|&&k| k > 0).map(|&k| k as usize - 1).find(|&k| {
+            let (lo, hi) = self.ranges[k];
+            lo <= v && v <= hi
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::transfer::presets;
+    use crate::volume::{Source, ValueMap, Voxels};
+    use glam::{UVec3, Vec3};
+
+    fn labels(codes: Vec<u8>) -> Arc<Volume> {
+        let n = codes.len() as u32;
+        let grid = Grid::new(UVec3::new(n, 1, 1), Vec3::ONE);
+        Arc::new(Volume::new("labels", grid, Voxels::U8(codes), ValueMap::IDENTITY, Source::default()).unwrap())
+    }
+
+    fn object(name: &str, codes: Vec<u32>, values: Option<(f64, f64)>) -> Object {
+        let tf = presets::builtin("grayscale_ramp").unwrap();
+        Object { values, ..Object::new(name, codes, Appearance::new(Mode::Mip, tf)) }
+    }
+
+    #[test]
+    fn first_listed_object_whose_range_holds_the_value_wins() {
+        let seg = Segmentation {
+            labels: labels(vec![0, 1, 2, 3]),
+            objects: vec![
+                object("bright background", vec![0], Some((128.0, 255.0))),
+                object("one and two", vec![1, 2], None),
+                object("anything dark", vec![], Some((0.0, 50.0))),
+            ],
+            rest_visible: true,
+        };
+        seg.validate().unwrap();
+        // The data volume maps codes 0…255 to themselves, normalised by 255.
+        let data = labels(vec![0, 255]);
+        let t = seg.table(&data);
+        let n = |x: f64| (x / 255.0) as f32;
+        assert_eq!(t.candidates[0], [1, 3, 0, 0]);
+        assert_eq!(t.candidates[1], [2, 3, 0, 0]);
+        assert_eq!(t.candidates[3], [3, 0, 0, 0]);
+        assert_eq!(t.object(0, n(200.0)), Some(0));
+        assert_eq!(t.object(0, n(128.0)), Some(0), "inclusive range");
+        assert_eq!(t.object(0, n(20.0)), Some(2), "falls through to the next object listing 0");
+        assert_eq!(t.object(0, n(90.0)), None, "in no object: the rest");
+        assert_eq!(t.object(2, n(90.0)), Some(1));
+        assert_eq!(t.object(3, n(60.0)), None);
+        assert_eq!(t.object(3, n(10.0)), Some(2));
+        assert_eq!(t.object(9, 0.5), None, "codes beyond the table: the rest");
+    }
+
+    #[test]
+    fn validation_names_the_problem() {
+        let mut seg =
+            Segmentation { labels: labels(vec![0, 1]), objects: vec![object("a", vec![1], Some((5.0, 1.0)))], rest_visible: true };
+        assert!(seg.validate().unwrap_err().contains("object 'a'"));
+        seg.objects = (0..5).map(|i| object(&format!("o{i}"), vec![1], None)).collect();
+        assert!(seg.validate().unwrap_err().contains("label 1 is listed by 5 objects"));
+        seg.objects = vec![Object {
+            appearance: Appearance {
+                lookup: Lookup::Labels(crate::transfer::LabelTransfer { styles: Default::default(), default_opacity: 0.0 }),
+                ..object("x", vec![], None).appearance
+            },
+            ..object("x", vec![], None)
+        }];
+        assert!(seg.validate().unwrap_err().contains("transfer function"));
+    }
+
+    #[test]
+    fn label_voxels_follow_the_data_grid() {
+        // Labels at half the resolution of the data, same world box origin.
+        let data = Grid::new(UVec3::new(8, 8, 8), Vec3::ONE);
+        let seg = Segmentation { labels: Arc::new(phantom_labels()), objects: vec![], rest_visible: true };
+        let m = seg.data_to_label(&data);
+        assert!((m.transform_point3(Vec3::new(6.0, 2.0, 4.0)) - Vec3::new(3.0, 1.0, 2.0)).length() < 1e-6);
+    }
+
+    fn phantom_labels() -> Volume {
+        let grid = Grid::new(UVec3::new(4, 4, 4), Vec3::splat(2.0));
+        Volume::new("half", grid, Voxels::U8(vec![0; 64]), ValueMap::IDENTITY, Source::default()).unwrap()
+    }
+}

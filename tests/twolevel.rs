@@ -1,0 +1,226 @@
+//! Two-level volume rendering on the CPU reference (`focal::twolevel`), against values
+//! worked out by hand: a MIP object emits one value per segment (two segments: two
+//! samples composited), segments composite front to back with the rest, a segmentation
+//! whose parts all draw alike is plain DVR, hidden objects are holes (their samples do
+//! not fall to the rest), value ranges move samples between objects, iso objects are
+//! opaque at their first crossing. Scene files name labels by pattern and report typos.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use focal::reference::{DEPTH_THRESHOLD, RenderScene, prepare, trace};
+use focal::region::{Appearance, Light, Mode, Ray};
+use focal::transfer::{ColorPoint, OpacityPoint, TransferFunction, ValueSpace};
+use focal::twolevel::{Object, Segmentation};
+use focal::volume::{Grid, Source, ValueMap, Volume, Voxels};
+use glam::{UVec3, Vec3};
+
+const N: u32 = 32;
+
+/// Data and labels on one 32³ grid centred on the origin:
+/// label 1, a ball of radius 7.5 at x = −8 holding a ball of value 150 (radius 5);
+/// label 2, a cube of half-size 7 at x = +8 holding a cube of value 100 (half-size 5,
+/// with a 2³ core of 220 at its centre), cut at z ∈ [−4, −2] by label 3; label 0, a
+/// plate (60) at z ∈ [−13, −11] behind everything seen from +z, and empty space (0).
+/// The labels reach 2 voxels beyond the data, so no sample of label 0 interpolates a
+/// non-zero value of the ball or the cube: every number below is exact.
+fn phantom() -> (Arc<Volume>, Arc<Volume>) {
+    let c = (N as f32 - 1.0) * 0.5;
+    let (mut data, mut labels) = (Vec::new(), Vec::new());
+    for i in 0..N * N * N {
+        let p = Vec3::new((i % N) as f32, (i / N % N) as f32, (i / (N * N)) as f32) - Vec3::splat(c);
+        let cube = p - Vec3::new(8.0, 0.0, 0.0);
+        let ball = (p - Vec3::new(-8.0, 0.0, 0.0)).length();
+        let (v, l) = if ball < 7.5 {
+            (if ball < 5.0 { 150 } else { 0 }, 1)
+        } else if cube.abs().max_element() < 7.0 {
+            let v = match cube.abs().max_element() {
+                d if d < 1.0 => 220,
+                d if d < 5.0 => 100,
+                _ => 0,
+            };
+            (v, if (-4.0..=-2.0).contains(&p.z) { 3 } else { 2 })
+        } else if (-13.0..=-11.0).contains(&p.z) {
+            (60, 0)
+        } else {
+            (0, 0)
+        };
+        data.push(v);
+        labels.push(l);
+    }
+    let grid = Grid::centered(UVec3::splat(N), Vec3::ONE);
+    let volume = |name: &str, codes: Vec<u8>| {
+        Arc::new(Volume::new(name, grid.clone(), Voxels::U8(codes), ValueMap::IDENTITY, Source::default()).unwrap())
+    };
+    (volume("data", data), volume("labels", labels))
+}
+
+/// White, opacity = value / 255.
+fn ramp() -> TransferFunction {
+    TransferFunction {
+        name: "ramp".into(),
+        space: ValueSpace::Absolute,
+        units: None,
+        color: vec![ColorPoint(0.0, [1.0, 1.0, 1.0])],
+        opacity: vec![OpacityPoint(0.0, 0.0), OpacityPoint(255.0, 1.0)],
+        lambda_t: vec![],
+        lambda_s: vec![],
+    }
+}
+
+fn unshaded(mode: Mode) -> Appearance {
+    let mut a = Appearance::new(mode, ramp());
+    a.shading.enabled = false;
+    a
+}
+
+fn object(name: &str, labels: Vec<u32>, mode: Mode) -> Object {
+    Object::new(name, labels, unshaded(mode))
+}
+
+fn scene(data: &Arc<Volume>, rest: Appearance, seg: Option<Segmentation>) -> RenderScene {
+    RenderScene::single(data.clone(), Appearance { segmentation: seg, ..rest })
+}
+
+/// Colour and opacity of the ray along −z through (x, y).
+fn pixel(scene: &RenderScene, x: f32, y: f32) -> glam::Vec4 {
+    let regions = prepare(scene).unwrap();
+    let ray = Ray { origin: Vec3::new(x, y, 60.0), dir: -Vec3::Z };
+    trace::trace(&regions, Light::Headlight, ray, 0.5, DEPTH_THRESHOLD, false).color
+}
+
+fn close(a: f32, b: f32, tol: f32) -> bool {
+    (a - b).abs() <= tol
+}
+
+#[test]
+fn a_mip_object_emits_one_value_per_segment() {
+    let (data, labels) = phantom();
+    let mut hidden_slab = object("slab", vec![3], Mode::Dvr);
+    hidden_slab.visible = false;
+    let seg = Segmentation { labels, objects: vec![object("cube", vec![2], Mode::Mip), hidden_slab], rest_visible: false };
+    let s = scene(&data, unshaded(Mode::Dvr), Some(seg));
+    // Off the core: the slab splits the cube into two segments of max 100 each, so two
+    // samples of opacity 100/255 composite: 1 − (1 − a)², not one max (a).
+    let a = 100.0 / 255.0;
+    let side = pixel(&s, 8.0, 3.0);
+    assert!(close(side.w, 1.0 - (1.0 - a) * (1.0 - a), 1e-4), "two segments: {} vs {}", side.w, 1.0 - (1.0 - a) * (1.0 - a));
+    // Through the core: the front segment's max is the core's 220.
+    let core = pixel(&s, 8.0, 0.0);
+    let expect = 1.0 - (1.0 - 220.0 / 255.0) * (1.0 - a);
+    assert!(close(core.w, expect, 1e-4), "core: {} vs {expect}", core.w);
+    // White colour, premultiplied.
+    assert!(close(core.x, core.w, 1e-5));
+    // Nothing else draws: the ball is in no object and the rest is hidden.
+    assert_eq!(pixel(&s, -8.0, 0.0).w, 0.0);
+}
+
+#[test]
+fn segments_composite_front_to_back_with_the_rest() {
+    let (data, labels) = phantom();
+    let seg = Segmentation { labels, objects: vec![object("cube", vec![2, 3], Mode::Mip)], rest_visible: true };
+    let s = scene(&data, unshaded(Mode::Dvr), Some(seg));
+    // The plate alone (rest, DVR) seen where nothing is in front of it.
+    let plate = pixel(&s, 0.0, 10.0).w;
+    assert!(plate > 0.3, "the plate should show: {plate}");
+    // Through the cube (one object, one segment: max 100) and then the plate behind.
+    let a = 100.0 / 255.0;
+    let both = pixel(&s, 8.0, 3.0).w;
+    let expect = a + (1.0 - a) * plate;
+    assert!(close(both, expect, 1e-3), "MIP over the plate: {both} vs {expect}");
+}
+
+#[test]
+fn parts_that_all_draw_alike_are_plain_dvr() {
+    let (data, labels) = phantom();
+    let a = Appearance::new(Mode::Dvr, ramp());
+    let plain = scene(&data, a.clone(), None);
+    let objects = vec![Object::new("ball", vec![1], a.clone()), Object::new("cube", vec![2, 3], a.clone())];
+    let seg = scene(&data, a.clone(), Some(Segmentation { labels, objects, rest_visible: true }));
+    for (x, y) in [(-8.0, 0.0), (8.0, 0.0), (8.0, 3.0), (0.0, 10.0), (-6.0, 2.5), (3.0, -4.0)] {
+        let (p, q) = (pixel(&plain, x, y), pixel(&seg, x, y));
+        assert!((p - q).abs().max_element() < 1e-6, "({x}, {y}): plain {p} vs segmented {q}");
+    }
+}
+
+#[test]
+fn a_hidden_object_is_a_hole_not_the_rest() {
+    let (data, labels) = phantom();
+    let rest = unshaded(Mode::Dvr);
+    let shown = scene(&data, rest.clone(), None);
+    let mut ball = object("ball", vec![1], Mode::Dvr);
+    ball.visible = false;
+    let hidden = scene(&data, rest, Some(Segmentation { labels, objects: vec![ball], rest_visible: true }));
+    let plate = pixel(&shown, 0.0, 10.0).w;
+    let (with, without) = (pixel(&shown, -8.0, 0.0).w, pixel(&hidden, -8.0, 0.0).w);
+    println!("ball shown {with}, hidden {without}, plate alone {plate}");
+    assert!(with > 0.99, "the ball is opaque under the ramp: {with}");
+    // Hidden: only the plate behind shows.
+    assert!(close(without, plate, 1e-5), "hidden ball: {without} vs the plate alone {plate}");
+}
+
+#[test]
+fn value_ranges_move_samples_between_objects() {
+    let (data, labels) = phantom();
+    let bright = |range: (f64, f64)| {
+        let mut o = object("plate", vec![0], Mode::Mip);
+        o.values = Some(range);
+        let seg = Segmentation { labels: labels.clone(), objects: vec![o], rest_visible: false };
+        pixel(&scene(&data, unshaded(Mode::Dvr), Some(seg)), 0.0, 10.0).w
+    };
+    // The plate's samples (60) are in the object: its MIP is 60/255.
+    assert!(close(bright((50.0, 70.0)), 60.0 / 255.0, 1e-4));
+    // Out of range they go to the rest, which is hidden.
+    assert_eq!(bright((200.0, 255.0)), 0.0);
+}
+
+#[test]
+fn an_iso_object_is_opaque_at_its_first_crossing() {
+    let (data, labels) = phantom();
+    let mut ball = object("ball", vec![1], Mode::Iso);
+    ball.appearance.iso_value = 75.0;
+    let seg = Segmentation { labels, objects: vec![ball], rest_visible: false };
+    let s = scene(&data, unshaded(Mode::Dvr), Some(seg));
+    let hit = pixel(&s, -8.0, 0.0);
+    assert!(close(hit.w, 1.0, 1e-6), "{hit}");
+    // Unshaded: the ramp's white.
+    assert!(close(hit.x, 1.0, 1e-6));
+    // Where the ray meets no ball there is nothing (the plate is the hidden rest).
+    assert_eq!(pixel(&s, 0.0, 10.0).w, 0.0);
+    // The depth is the ball's front surface (value 75 is half-way up its edge at z ≈ 5).
+    let regions = prepare(&s).unwrap();
+    let t =
+        trace::trace(&regions, Light::Headlight, Ray { origin: Vec3::new(-8.0, 0.0, 60.0), dir: -Vec3::Z }, 0.5, DEPTH_THRESHOLD, false);
+    assert!(close(60.0 - t.depth, 5.0, 0.6), "surface at z = {}", 60.0 - t.depth);
+}
+
+#[test]
+fn scene_files_name_labels_and_report_typos() {
+    use focal::scene::file::SceneFile;
+    use focal::scene::load_datasets;
+    let text = |names: &str| {
+        format!(
+            r#"(datasets: [
+                (source: File("../shared/data/mri/ch2.nii.gz"),
+                 appearance: (mode: dvr, segmentation: Some((labels: 1, objects: [
+                    (name: "hippocampus", names: [{names}], appearance: (mode: dvr)),
+                    (name: "scalp", labels: [0], values: Some((125.0, 255.0)), appearance: (mode: mip)),
+                 ])))),
+                (source: File("../shared/data/labels/aal.nii.gz"), appearance: (labels: Some(())), visible: false),
+            ])"#
+        )
+    };
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = SceneFile::parse(&text(r#""Hippocampus_*""#), "t").unwrap();
+    let d = load_datasets(&scene, root).unwrap();
+    let seg = d[0].appearance.segmentation.as_ref().unwrap();
+    // AAL numbers the left and right hippocampus 37 and 38.
+    assert_eq!(seg.objects[0].labels, vec![37, 38]);
+    assert_eq!(seg.objects[1].values, Some((125.0, 255.0)));
+    assert!(std::sync::Arc::ptr_eq(&seg.labels, &d[1].volume));
+    let typo = SceneFile::parse(&text(r#""Hipocampus_*""#), "t").unwrap();
+    let e = load_datasets(&typo, root).unwrap_err();
+    assert!(e.contains("dataset 0") && e.contains("'hippocampus'") && e.contains("Hipocampus_*"), "{e}");
+    let bad_index = SceneFile::parse(&text(r#""Hippocampus_*""#).replace("labels: 1,", "labels: 7,"), "t").unwrap();
+    assert!(load_datasets(&bad_index, root).unwrap_err().contains("labels refers to dataset 7"));
+}
