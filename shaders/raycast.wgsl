@@ -131,10 +131,15 @@ fn refine_iso(r: Region, ray: Ray, ta_in: f32, va: f32, tb_in: f32) -> f32 {
     return 0.5 * (ta + tb);
 }
 
+// The iso-surface at voxel position q, shaded and opaque (reference: trace::iso_surface).
+fn iso_surface(r: Region, q: vec3<f32>, dir: vec3<f32>, acc: vec4<f32>) -> vec4<f32> {
+    let rgba = classify(r, r.iso, scene.lut_atlas_width);
+    return composite(acc, shaded(r, rgba.rgb, q, dir), 1.0);
+}
+
 fn iso_hit(r: Region, ray: Ray, tp: f32, vp: f32, t: f32, acc: vec4<f32>) -> vec4<f32> {
     let th = refine_iso(r, ray, tp, vp, t);
-    let rgba = classify(r, r.iso, scene.lut_atlas_width);
-    return composite(acc, shaded(r, rgba.rgb, to_voxel(r, ray.origin + ray.dir * th), ray.dir), 1.0);
+    return iso_surface(r, to_voxel(r, ray.origin + ray.dir * th), ray.dir, acc);
 }
 
 // The sample grid of a one-region segment: sample kk lies at t_start + (kk + j)·step on
@@ -263,7 +268,11 @@ fn two_level_sample(r: Region, open: ptr<function, Open>, q: vec3<f32>, ratio: f
 #ifdef HAS_ISO
     if part.mode == MODE_ISO {
         let vi = v - part.iso;
-        if ((*open).flags & HAS_PREV) != 0u && (((*open).prev_v < 0.0) != (vi < 0.0)) {
+        if ((*open).flags & HAS_PREV) == 0u && vi >= 0.0 {
+            // The segment starts inside the surface: the object's boundary is its surface.
+            out = iso_surface(part, q, ray.dir, out);
+            (*open).flags |= DONE;
+        } else if ((*open).flags & HAS_PREV) != 0u && (((*open).prev_v < 0.0) != (vi < 0.0)) {
             out = iso_hit(part, ray, (*open).prev_t, (*open).prev_v, t, out);
             (*open).flags |= DONE;
         } else {

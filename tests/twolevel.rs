@@ -98,7 +98,7 @@ fn a_mip_object_emits_one_value_per_segment() {
     let (data, labels) = phantom();
     let mut hidden_slab = object("slab", vec![3], Mode::Dvr);
     hidden_slab.visible = false;
-    let seg = Segmentation { labels, objects: vec![object("cube", vec![2], Mode::Mip), hidden_slab], rest_visible: false };
+    let seg = Segmentation { table: None, labels, objects: vec![object("cube", vec![2], Mode::Mip), hidden_slab], rest_visible: false };
     let s = scene(&data, unshaded(Mode::Dvr), Some(seg));
     // Off the core: the slab splits the cube into two segments of max 100 each, so two
     // samples of opacity 100/255 composite: 1 − (1 − a)², not one max (a).
@@ -118,7 +118,7 @@ fn a_mip_object_emits_one_value_per_segment() {
 #[test]
 fn segments_composite_front_to_back_with_the_rest() {
     let (data, labels) = phantom();
-    let seg = Segmentation { labels, objects: vec![object("cube", vec![2, 3], Mode::Mip)], rest_visible: true };
+    let seg = Segmentation { table: None, labels, objects: vec![object("cube", vec![2, 3], Mode::Mip)], rest_visible: true };
     let s = scene(&data, unshaded(Mode::Dvr), Some(seg));
     // The plate alone (rest, DVR) seen where nothing is in front of it.
     let plate = pixel(&s, 0.0, 10.0).w;
@@ -136,7 +136,7 @@ fn parts_that_all_draw_alike_are_plain_dvr() {
     let a = Appearance::new(Mode::Dvr, ramp());
     let plain = scene(&data, a.clone(), None);
     let objects = vec![Object::new("ball", vec![1], a.clone()), Object::new("cube", vec![2, 3], a.clone())];
-    let seg = scene(&data, a.clone(), Some(Segmentation { labels, objects, rest_visible: true }));
+    let seg = scene(&data, a.clone(), Some(Segmentation { table: None, labels, objects, rest_visible: true }));
     for (x, y) in [(-8.0, 0.0), (8.0, 0.0), (8.0, 3.0), (0.0, 10.0), (-6.0, 2.5), (3.0, -4.0)] {
         let (p, q) = (pixel(&plain, x, y), pixel(&seg, x, y));
         assert!((p - q).abs().max_element() < 1e-6, "({x}, {y}): plain {p} vs segmented {q}");
@@ -150,7 +150,7 @@ fn a_hidden_object_is_a_hole_not_the_rest() {
     let shown = scene(&data, rest.clone(), None);
     let mut ball = object("ball", vec![1], Mode::Dvr);
     ball.visible = false;
-    let hidden = scene(&data, rest, Some(Segmentation { labels, objects: vec![ball], rest_visible: true }));
+    let hidden = scene(&data, rest, Some(Segmentation { table: None, labels, objects: vec![ball], rest_visible: true }));
     let plate = pixel(&shown, 0.0, 10.0).w;
     let (with, without) = (pixel(&shown, -8.0, 0.0).w, pixel(&hidden, -8.0, 0.0).w);
     println!("ball shown {with}, hidden {without}, plate alone {plate}");
@@ -165,7 +165,7 @@ fn value_ranges_move_samples_between_objects() {
     let bright = |range: (f64, f64)| {
         let mut o = object("plate", vec![0], Mode::Mip);
         o.values = Some(range);
-        let seg = Segmentation { labels: labels.clone(), objects: vec![o], rest_visible: false };
+        let seg = Segmentation { table: None, labels: labels.clone(), objects: vec![o], rest_visible: false };
         pixel(&scene(&data, unshaded(Mode::Dvr), Some(seg)), 0.0, 10.0).w
     };
     // The plate's samples (60) are in the object: its MIP is 60/255.
@@ -179,7 +179,7 @@ fn an_iso_object_is_opaque_at_its_first_crossing() {
     let (data, labels) = phantom();
     let mut ball = object("ball", vec![1], Mode::Iso);
     ball.appearance.iso_value = 75.0;
-    let seg = Segmentation { labels, objects: vec![ball], rest_visible: false };
+    let seg = Segmentation { table: None, labels, objects: vec![ball], rest_visible: false };
     let s = scene(&data, unshaded(Mode::Dvr), Some(seg));
     let hit = pixel(&s, -8.0, 0.0);
     assert!(close(hit.w, 1.0, 1e-6), "{hit}");
@@ -192,6 +192,19 @@ fn an_iso_object_is_opaque_at_its_first_crossing() {
     let t =
         trace::trace(&regions, Light::Headlight, Ray { origin: Vec3::new(-8.0, 0.0, 60.0), dir: -Vec3::Z }, 0.5, DEPTH_THRESHOLD, false);
     assert!(close(60.0 - t.depth, 5.0, 0.6), "surface at z = {}", 60.0 - t.depth);
+    // An iso-value every sample of the object reaches: the surface is the label's
+    // boundary, where the segment starts. On this ray the last voxel of the ball (radius
+    // 7.5 around (−8, 0, 0)) is the one centred at z = 6.5 (√(0.5 + 6.5²) < 7.5 <
+    // √(0.5 + 7.5²)); its cell ends at z = 7, and the first sample inside lies at most
+    // one step (0.5) below.
+    let mut s = s;
+    s.appearances[0].segmentation.as_mut().unwrap().objects[0].appearance.iso_value = 0.0;
+    let regions = prepare(&s).unwrap();
+    let t =
+        trace::trace(&regions, Light::Headlight, Ray { origin: Vec3::new(-8.0, 0.0, 60.0), dir: -Vec3::Z }, 0.5, DEPTH_THRESHOLD, false);
+    let z = 60.0 - t.depth;
+    assert!(z > 6.5 - 1e-4 && z <= 7.0 + 1e-4, "boundary surface at z = {z}");
+    assert!(close(t.color.w, 1.0, 1e-6));
 }
 
 #[test]
@@ -223,4 +236,61 @@ fn scene_files_name_labels_and_report_typos() {
     assert!(e.contains("dataset 0") && e.contains("'hippocampus'") && e.contains("Hipocampus_*"), "{e}");
     let bad_index = SceneFile::parse(&text(r#""Hippocampus_*""#).replace("labels: 1,", "labels: 7,"), "t").unwrap();
     assert!(load_datasets(&bad_index, root).unwrap_err().contains("labels refers to dataset 7"));
+}
+
+#[test]
+fn picking_names_the_label_of_a_segmented_volume() {
+    let (data, labels) = phantom();
+    let ball = object("ball", vec![1], Mode::Dvr);
+    let seg = Segmentation { table: None, labels, objects: vec![ball], rest_visible: true };
+    // The rest opaque from value 55: the plate stops a pick.
+    let mut opaque = ramp();
+    opaque.opacity = vec![OpacityPoint(0.0, 0.0), OpacityPoint(50.0, 0.0), OpacityPoint(55.0, 1.0)];
+    let mut s = scene(&data, Appearance::new(Mode::Dvr, opaque), Some(seg));
+    let ray = Ray { origin: Vec3::new(-8.0, 0.0, 60.0), dir: -Vec3::Z };
+    let hit = focal::reference::pick(&s, ray).unwrap().unwrap();
+    assert_eq!(focal::reference::label_at(&s, &hit), Some(1));
+    // Hidden, the ball lets the pick through to the plate (label 0, the rest).
+    s.appearances[0].segmentation.as_mut().unwrap().objects[0].visible = false;
+    let hit = focal::reference::pick(&s, ray).unwrap().unwrap();
+    assert_eq!(focal::reference::label_at(&s, &hit), Some(0));
+    assert!(hit.position.z < -10.0, "{}", hit.position);
+}
+
+#[test]
+fn segmentations_are_saved_and_load_back() {
+    use focal::scene::file::SceneFile;
+    use focal::scene::load_datasets;
+    use focal::scene::save::{DatasetState, scene_file};
+    let original = SceneFile::parse(
+        r#"(datasets: [
+            (source: Phantom(kind: head, resolution: 32), appearance: (mode: context, segmentation: Some((labels: 1, rest_visible: false, objects: [
+                (name: "bone", names: ["skull"], values: Some((300.0, 3000.0)), appearance: (mode: mip, preset: Some("grayscale_ramp"))),
+                (name: "vessels", names: ["arteries"], visible: false, appearance: (mode: dvr, preset: Some("ct_vessels"))),
+            ])))),
+            (source: PhantomLabels(resolution: 32), appearance: (labels: Some(())), visible: false),
+        ])"#,
+        "t",
+    )
+    .unwrap();
+    let loaded = load_datasets(&original, Path::new(".")).unwrap();
+    let states: Vec<DatasetState> = loaded
+        .iter()
+        .map(|d| DatasetState {
+            spec: &d.spec,
+            appearance: &d.appearance,
+            translation: Vec3::ZERO,
+            rotation: glam::Quat::IDENTITY,
+            visible: d.visible,
+            clip: &d.clip,
+        })
+        .collect();
+    let cam = focal::region::View::Left.frame(Vec3::ZERO, 20.0, true);
+    let saved = scene_file(&states, &cam, [0.0; 3], Light::Headlight, (64, 64), &[], Path::new("."));
+    let text = saved.to_ron().unwrap();
+    let again = load_datasets(&SceneFile::parse(&text, "saved").unwrap(), Path::new(".")).unwrap();
+    let (a, b) = (loaded[0].appearance.segmentation.as_ref().unwrap(), again[0].appearance.segmentation.as_ref().unwrap());
+    assert_eq!(a.objects, b.objects, "objects survive saving (names resolved to codes)");
+    assert!(!b.rest_visible);
+    assert_eq!(b.objects[0].labels, vec![focal::volume::phantom::head::label::SKULL as u32]);
 }

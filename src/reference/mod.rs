@@ -94,15 +94,18 @@ pub struct Hit {
 }
 
 /// The label id at a hit on a label volume (its nearest voxel: the label whose sample
-/// made the ray opaque there); `None` on other regions.
+/// made the ray opaque there), or on a segmented volume (the label of its segmentation
+/// there); `None` on other regions.
 pub fn label_at(scene: &RenderScene, hit: &Hit) -> Option<u32> {
     let region = scene.regions.get(hit.region)?;
-    if !matches!(scene.appearances.get(region.appearance)?.lookup, crate::region::Lookup::Labels(_)) {
-        return None;
-    }
+    let appearance = scene.appearances.get(region.appearance)?;
     let volume = scene.volumes.get(region.volume)?;
     let q = region.world_to_voxel.transform_point3(hit.position);
-    Some(crate::volume::sample::VolumeSampler::of(volume).nearest(q) as u32)
+    match (&appearance.lookup, &appearance.segmentation) {
+        (_, Some(seg)) => seg.label_at(&volume.grid, q),
+        (crate::region::Lookup::Labels(_), None) => Some(crate::volume::sample::VolumeSampler::of(volume).nearest(q) as u32),
+        _ => None,
+    }
 }
 
 /// First visible point along `ray` under the scene's transfer functions.

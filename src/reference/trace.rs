@@ -16,7 +16,12 @@
 //!    - MIP / MinIP / X-ray: the region keeps the max / min / mean of its samples and
 //!      emits `TF(value)` as one sample when the ray leaves its interval;
 //!    - iso-surface: the first sign change of `f − iso` between samples is refined by
-//!      bisection, shaded and composited as an opaque sample.
+//!      bisection, shaded and composited as an opaque sample;
+//!    - segmented regions ([`crate::twolevel`]): each sample's object (from the label
+//!      volume and the value) selects the part whose mode applies; where the object
+//!      changes, a segment ends and its projection is emitted; an iso-surface object
+//!      whose segment starts at or above the iso-value has its surface there (its
+//!      label's boundary).
 //! 4. Stop early once `A ≥ 0.99` (or at the pick threshold when picking).
 //!
 //! The GPU shader implements the same function; keep them in step.
@@ -171,8 +176,17 @@ pub fn trace_antialiased(
                         close(&mut out, r, st, t, i, depth_threshold);
                         st.part = Some(part);
                     }
-                    if objects.visible[part] && !st.gathered.done {
-                        sample(&mut out, &objects.parts[part], &mut st.gathered, st.ratio, q, t, i, &at);
+                    let shown = &objects.parts[part];
+                    if !objects.visible[part] || st.gathered.done {
+                        continue;
+                    }
+                    if shown.mode == Mode::Iso && st.gathered.prev.is_none() && shown.sample(q, at.level) >= shown.iso {
+                        // The segment starts inside the iso-surface: the object's
+                        // boundary is its surface.
+                        iso_surface(&mut out, shown, q, t, i, &at);
+                        st.gathered.done = true;
+                    } else {
+                        sample(&mut out, shown, &mut st.gathered, st.ratio, q, t, i, &at);
                     }
                 }
             }
@@ -244,17 +258,22 @@ fn sample(out: &mut Traced, r: &PreparedRegion, g: &mut Gathered, ratio: f32, q:
                 && (vp < 0.0) != (v < 0.0)
             {
                 let th = refine(r, ray, (tp, vp), (t, v), level);
-                let qh = r.region.world_to_voxel.transform_point3(ray.at(th));
-                let rgba = r.lookup.classify(r.iso, r.sampler.nearest(qh));
-                let grad = r.index_gradient_at(qh, level);
-                let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), r.normal_matrix * grad, view, light, &r.shading);
-                composite(out, c, 1.0, th, i, depth_threshold);
+                iso_surface(out, r, r.region.world_to_voxel.transform_point3(ray.at(th)), th, i, at);
                 g.done = true;
             } else {
                 g.prev = Some((t, v));
             }
         }
     }
+}
+
+/// The iso-surface of region `r` at voxel position `qh` (ray parameter `th`), shaded
+/// and opaque.
+fn iso_surface(out: &mut Traced, r: &PreparedRegion, qh: Vec3, th: f32, i: usize, at: &Sampling) {
+    let rgba = r.lookup.classify(r.iso, r.sampler.nearest(qh));
+    let grad = r.index_gradient_at(qh, at.level);
+    let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), r.normal_matrix * grad, at.ray.dir, at.light, &r.shading);
+    composite(out, c, 1.0, th, i, at.depth_threshold);
 }
 
 /// Ends what region `r` has gathered at ray parameter `t` (leaving the region, or its

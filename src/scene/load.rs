@@ -109,7 +109,8 @@ pub fn segmentation(spec: &SegmentationSpec, datasets: &[LoadedDataset], data: &
             })
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let seg = Segmentation { labels: source.volume.clone(), objects, rest_visible: spec.rest_visible };
+    let seg =
+        Segmentation { table: source.table.clone().map(Arc::new), labels: source.volume.clone(), objects, rest_visible: spec.rest_visible };
     seg.validate()?;
     Ok(seg)
 }

@@ -15,7 +15,7 @@ use std::sync::Arc;
 use glam::Affine3A;
 
 use crate::region::{Appearance, Lookup, Mode};
-use crate::volume::{Grid, Volume};
+use crate::volume::{Grid, LabelTable, Volume};
 
 /// Most objects of one segmentation (the shader keeps one region record per object).
 pub const MAX_OBJECTS: usize = 64;
@@ -29,6 +29,8 @@ pub struct Segmentation {
     /// grids' world coordinates are the same scanner space), so it follows the data
     /// volume wherever a region shows it.
     pub labels: Arc<Volume>,
+    /// Names and colours of the labels, when the label volume has a table.
+    pub table: Option<Arc<LabelTable>>,
     pub objects: Vec<Object>,
     /// Whether samples in no object are drawn (with the data volume's own appearance).
     pub rest_visible: bool,
@@ -95,6 +97,27 @@ impl Segmentation {
             }
         }
         Ok(())
+    }
+
+    /// The label code at data voxel index `q` (nearest label voxel; `None` outside).
+    pub fn label_at(&self, data: &Grid, q: glam::Vec3) -> Option<u32> {
+        let l = (self.data_to_label(data).transform_point3(q) + 0.5).floor();
+        let dims = self.labels.dims().as_vec3();
+        if l.cmplt(glam::Vec3::ZERO).any() || l.cmpge(dims).any() {
+            return None;
+        }
+        let u = l.as_uvec3();
+        Some(self.labels.code(u.x, u.y, u.z) as u32)
+    }
+
+    /// The name of label `code` (from the table, else its number).
+    pub fn label_name(&self, code: u32) -> String {
+        self.table.as_ref().map_or_else(|| format!("label {code}"), |t| t.name(code))
+    }
+
+    /// The first object listing `code` (whatever its value range).
+    pub fn object_of_label(&self, code: u32) -> Option<usize> {
+        self.objects.iter().position(|o| o.takes_code(code))
     }
 
     /// Map from the data volume's voxel index to the label volume's.
@@ -203,8 +226,12 @@ mod tests {
 
     #[test]
     fn validation_names_the_problem() {
-        let mut seg =
-            Segmentation { labels: labels(vec![0, 1]), objects: vec![object("a", vec![1], Some((5.0, 1.0)))], rest_visible: true };
+        let mut seg = Segmentation {
+            table: None,
+            labels: labels(vec![0, 1]),
+            objects: vec![object("a", vec![1], Some((5.0, 1.0)))],
+            rest_visible: true,
+        };
         assert!(seg.validate().unwrap_err().contains("object 'a'"));
         seg.objects = (0..5).map(|i| object(&format!("o{i}"), vec![1], None)).collect();
         assert!(seg.validate().unwrap_err().contains("label 1 is listed by 5 objects"));
@@ -222,7 +249,7 @@ mod tests {
     fn label_voxels_follow_the_data_grid() {
         // Labels at half the resolution of the data, same world box origin.
         let data = Grid::new(UVec3::new(8, 8, 8), Vec3::ONE);
-        let seg = Segmentation { labels: Arc::new(phantom_labels()), objects: vec![], rest_visible: true };
+        let seg = Segmentation { table: None, labels: Arc::new(phantom_labels()), objects: vec![], rest_visible: true };
         let m = seg.data_to_label(&data);
         assert!((m.transform_point3(Vec3::new(6.0, 2.0, 4.0)) - Vec3::new(3.0, 1.0, 2.0)).length() < 1e-6);
     }

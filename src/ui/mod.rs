@@ -9,6 +9,7 @@ pub mod clip_gizmo;
 pub mod clip_panel;
 pub mod lenses;
 pub mod loading;
+pub mod objects_panel;
 pub mod orbit;
 pub mod panels;
 pub mod tf_editor;

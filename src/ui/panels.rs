@@ -9,7 +9,7 @@ use bevy_egui::{EguiContexts, egui::Ui};
 
 use super::loading::{DatasetOrigin, LoadRequest, Loading, Session};
 use super::orbit::{OrbitCamera, PointerInViewport};
-use super::{AppState, DialogPurpose, MainCamera, SHORTCUTS, lenses, scene_bounds, set_viewport, tf_editor};
+use super::{AppState, DialogPurpose, MainCamera, SHORTCUTS, lenses, objects_panel, scene_bounds, set_viewport, tf_editor};
 use crate::context::{ContextParams, Power};
 use crate::dataset::{Dataset, GpuVolume, SceneLight, SceneRegions};
 use crate::region::{Light, Lookup, Mode, View};
@@ -100,8 +100,29 @@ pub fn ui(
                     dataset_info(ui, d);
                 }
             });
+            let sources: Vec<objects_panel::LabelSource> = ds
+                .iter()
+                .enumerate()
+                .filter(|(i, (_, d, ..))| *i != selected && d.labels.is_some())
+                .map(|(_, (_, d, gpu, ..))| objects_panel::LabelSource {
+                    name: d.volume.name.clone(),
+                    volume: gpu.map_or_else(|| d.volume.clone(), |g| g.volume.clone()),
+                    table: d.labels.clone(),
+                })
+                .collect();
             if let Some((entity, d, _, _, transform)) = ds.get_mut(selected) {
                 let entity = *entity;
+                if matches!(d.appearance.lookup, Lookup::Transfer(_)) && (!sources.is_empty() || d.appearance.segmentation.is_some()) {
+                    egui::CollapsingHeader::new("Objects (two-level)").default_open(true).show(ui, |ui| {
+                        let picked = state.editor.picked_label.filter(|(e, _)| *e == entity).map(|(_, id)| id);
+                        let mut seg = d.appearance.segmentation.clone();
+                        let sel = objects_panel::Selection { picked, editing: &mut state.editor.object };
+                        objects_panel::panel(ui, &d.volume, &mut seg, &sources, sel);
+                        if seg != d.appearance.segmentation {
+                            d.appearance.segmentation = seg;
+                        }
+                    });
+                }
                 egui::CollapsingHeader::new("Transfer function")
                     .default_open(true)
                     .show(ui, |ui| transfer_panel(ui, d, entity, &mut state.editor));
@@ -228,8 +249,17 @@ fn dataset_info(ui: &mut Ui, d: &Dataset) {
 
 fn transfer_panel(ui: &mut Ui, d: &mut Dataset, entity: Entity, editor: &mut tf_editor::EditorState) {
     let hist = d.volume.stats.histogram.clone();
-    let lambda = d.appearance.mode == Mode::Context;
-    match &mut d.appearance.lookup {
+    // A segmented dataset's object, or the dataset itself (the rest).
+    let object = editor.object.filter(|k| d.appearance.segmentation.as_ref().is_some_and(|s| *k < s.objects.len()));
+    let appearance = match (object, &mut d.appearance.segmentation) {
+        (Some(k), Some(seg)) => {
+            ui.label(RichText::new(format!("editing object '{}'", seg.objects[k].name)).strong());
+            &mut seg.objects[k].appearance
+        }
+        _ => &mut d.appearance,
+    };
+    let lambda = appearance.mode == Mode::Context;
+    match &mut appearance.lookup {
         Lookup::Transfer(tf) => {
             egui::ComboBox::from_label("preset").selected_text(tf.name.clone()).show_ui(ui, |ui| {
                 for key in presets::names() {

@@ -22,6 +22,9 @@ pub struct EditorState {
     pub channel: Channel,
     /// The label last picked in the viewport (dataset, label id), shown in the list.
     pub picked_label: Option<(bevy::prelude::Entity, u32)>,
+    /// The object of a segmented dataset whose transfer function is edited (`None`:
+    /// the dataset's own).
+    pub object: Option<usize>,
 }
 
 /// The scalar channels of a transfer function.

@@ -1,6 +1,6 @@
 //! GPU image tests of two-level rendering: the head phantom's CT split by its own
-//! labels (arteries DVR, skull MIP, ventricles X-ray, eyes hidden, the rest
-//! context-preserving) against the CPU reference, alone (one-region loop) and
+//! labels (arteries DVR, skull MIP, ventricles X-ray, calcifications iso, eyes
+//! hidden, the rest context-preserving) against the CPU reference, alone (one-region loop) and
 //! overlapping a second copy of itself (the sample-by-sample loop).
 
 use super::*;
@@ -19,9 +19,14 @@ fn segmented_head() -> (Arc<Volume>, Appearance) {
         Object::new("skull", vec![label::SKULL as u32], Appearance::new(Mode::Mip, tf("grayscale_ramp"))),
         Object::new("ventricles", vec![label::VENTRICLES as u32], Appearance::new(Mode::XRay, tf("grayscale_ramp"))),
         eyes,
+        Object::new(
+            "calcifications",
+            vec![label::CALCIFICATIONS as u32],
+            Appearance { iso_value: 400.0, ..Appearance::new(Mode::Iso, tf("ct_bone")) },
+        ),
     ];
     let rest = Appearance {
-        segmentation: Some(Segmentation { labels: Arc::new(h.labels.volume), objects, rest_visible: true }),
+        segmentation: Some(Segmentation { table: None, labels: Arc::new(h.labels.volume), objects, rest_visible: true }),
         ..Appearance::new(Mode::Context, tf("ct_skin_bone"))
     };
     (ct, rest)
