@@ -198,6 +198,7 @@ mod tests {
     #[test]
     fn first_listed_object_whose_range_holds_the_value_wins() {
         let seg = Segmentation {
+            table: None,
             labels: labels(vec![0, 1, 2, 3]),
             objects: vec![
                 object("bright background", vec![0], Some((128.0, 255.0))),
