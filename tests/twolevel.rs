@@ -274,17 +274,7 @@ fn segmentations_are_saved_and_load_back() {
     )
     .unwrap();
     let loaded = load_datasets(&original, Path::new(".")).unwrap();
-    let states: Vec<DatasetState> = loaded
-        .iter()
-        .map(|d| DatasetState {
-            spec: &d.spec,
-            appearance: &d.appearance,
-            translation: Vec3::ZERO,
-            rotation: glam::Quat::IDENTITY,
-            visible: d.visible,
-            clip: &d.clip,
-        })
-        .collect();
+    let states: Vec<DatasetState> = loaded.iter().map(DatasetState::of).collect();
     let cam = focal::region::View::Left.frame(Vec3::ZERO, 20.0, true);
     let saved = scene_file(&states, &cam, [0.0; 3], Light::Headlight, (64, 64), &[], Path::new("."));
     let text = saved.to_ron().unwrap();

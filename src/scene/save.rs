@@ -24,6 +24,14 @@ pub struct DatasetState<'a> {
     pub clip: &'a Clipping,
 }
 
+impl<'a> DatasetState<'a> {
+    /// A dataset as a scene file loaded it.
+    pub fn of(d: &'a super::load::LoadedDataset) -> Self {
+        let (_, rotation, translation) = d.transform.to_scale_rotation_translation();
+        DatasetState { spec: &d.spec, appearance: &d.appearance, translation, rotation, visible: d.visible, clip: &d.clip }
+    }
+}
+
 /// The appearance as a spec.
 pub fn appearance_spec(a: &Appearance, labels_table: Option<&LabelsSpec>) -> AppearanceSpec {
     let (transfer, labels) = match &a.lookup {
@@ -161,17 +169,8 @@ mod tests {
         )
         .unwrap();
         let loaded = load_datasets(&original, Path::new(".")).unwrap();
-        let states: Vec<DatasetState> = loaded
-            .iter()
-            .map(|d| DatasetState {
-                spec: &d.spec,
-                appearance: &d.appearance,
-                translation: Vec3::new(1.0, 2.0, 3.0),
-                rotation: Quat::IDENTITY,
-                visible: d.visible,
-                clip: &d.clip,
-            })
-            .collect();
+        let states: Vec<DatasetState> =
+            loaded.iter().map(|d| DatasetState { translation: Vec3::new(1.0, 2.0, 3.0), ..DatasetState::of(d) }).collect();
         let cam = View::Left.frame(Vec3::ZERO, 20.0, true);
         let lenses = vec![
             crate::lens::Lens::magnifier(glam::Vec2::new(0.1, -0.2), 0.3, 0.1, 2.5),
