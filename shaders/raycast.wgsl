@@ -64,6 +64,11 @@ fn dvr_sample(r: Region, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f
     v = trilinear(r, q);
     rgba = classify(r, v, scene.lut_atlas_width);
 #endif
+    return dvr_classified(r, q, v, rgba, ratio, ray, t, acc);
+}
+
+// dvr_sample after classification: value v (0 for labels) gave rgba.
+fn dvr_classified(r: Region, q: vec3<f32>, v: f32, rgba: vec4<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
     if rgba.a <= 0.0 {
         return acc;
     }
@@ -204,9 +209,9 @@ fn fresh(part: u32) -> Open {
 
 // The part (object, or the rest: the last part) of a sample of segmented region r at
 // world point p with normalised value v: the first candidate object of its label code
-// whose value range holds v (reference: twolevel::ObjectTable::object).
-fn part_of(r: Region, p: vec3<f32>, v: f32) -> u32 {
-    let labels = regions[r.objects.z];
+// whose value range holds v (reference: twolevel::ObjectTable::object). `labels` is
+// r's label record.
+fn part_of(r: Region, labels: Region, p: vec3<f32>, v: f32) -> u32 {
     let code = nearest_code(labels, to_voxel(labels, p));
     let rest = r.objects.y - 1u;
     if code >= labels.lut_width {
@@ -218,46 +223,53 @@ fn part_of(r: Region, p: vec3<f32>, v: f32) -> u32 {
         if k == 0u {
             break;
         }
-        let part = regions[r.objects.x + k - 1u];
-        if part.value_lo <= v && v <= part.value_hi {
+        let index = r.objects.x + k - 1u;
+        if regions[index].value_lo <= v && v <= regions[index].value_hi {
             return k - 1u;
         }
     }
     return rest;
 }
 
-// Ends the open segment: a projection part emits its value as one sample (reference:
-// trace::close).
-fn close_segment(r: Region, open: ptr<function, Open>, acc: vec4<f32>) -> vec4<f32> {
+// Ends the open segment, whose part record is `part`: a projection part emits its value
+// as one sample (reference: trace::close).
+fn close_segment(r: Region, part: Region, open: ptr<function, Open>, acc: vec4<f32>) -> vec4<f32> {
     var out = acc;
     let o = *open;
-    if o.part < r.objects.y && o.count > 0u {
-        let part = regions[r.objects.x + o.part];
-        if is_projection(part.mode) {
-            let rgba = classify(part, projected(part.mode, o.max, o.min, o.sum, o.count), scene.lut_atlas_width);
-            out = composite(acc, rgba.rgb, rgba.a);
-        }
+    if o.part < r.objects.y && o.count > 0u && is_projection(part.mode) {
+        let rgba = classify(part, projected(part.mode, o.max, o.min, o.sum, o.count), scene.lut_atlas_width);
+        out = composite(acc, rgba.rgb, rgba.a);
     }
     *open = fresh(o.part);
     return out;
 }
 
+// Ends the open segment where the ray skips an empty brick: the next sample starts a
+// new one (what the brick's own samples would have done: no part there draws).
+fn end_segment(r: Region, part: Region, open: ptr<function, Open>, acc: vec4<f32>) -> vec4<f32> {
+    let out = close_segment(r, part, open, acc);
+    (*open).part = NO_PART;
+    return out;
+}
+
 // One sample of segmented region r at voxel q (world: ray at t): a new segment where
 // the part changes, then the part's mode (reference: the Some(objects) arm of trace).
-fn two_level_sample(r: Region, open: ptr<function, Open>, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
+// `labels` is r's label record; `part` holds the record of the open segment's part
+// (loaded here when the part changes, so a segment reads it once).
+fn two_level_sample(r: Region, labels: Region, part: ptr<function, Region>, open: ptr<function, Open>, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
     let v = trilinear(r, q);
-    let k = part_of(r, ray.origin + ray.dir * t, v);
+    let k = part_of(r, labels, ray.origin + ray.dir * t, v);
     var out = acc;
     if k != (*open).part {
-        out = close_segment(r, open, out);
+        out = close_segment(r, *part, open, out);
         (*open).part = k;
+        *part = regions[r.objects.x + k];
     }
-    let part = regions[r.objects.x + k];
-    if part.mode == MODE_OFF || ((*open).flags & DONE) != 0u {
+    if (*part).mode == MODE_OFF || ((*open).flags & DONE) != 0u {
         return out;
     }
 #ifdef HAS_PROJECTION
-    if is_projection(part.mode) {
+    if is_projection((*part).mode) {
         (*open).max = max((*open).max, v);
         (*open).min = min((*open).min, v);
         (*open).sum += v;
@@ -266,14 +278,14 @@ fn two_level_sample(r: Region, open: ptr<function, Open>, q: vec3<f32>, ratio: f
     }
 #endif
 #ifdef HAS_ISO
-    if part.mode == MODE_ISO {
-        let vi = v - part.iso;
+    if (*part).mode == MODE_ISO {
+        let vi = v - (*part).iso;
         if ((*open).flags & HAS_PREV) == 0u && vi >= 0.0 {
             // The segment starts inside the surface: the object's boundary is its surface.
-            out = iso_surface(part, q, ray.dir, out);
+            out = iso_surface(*part, q, ray.dir, out);
             (*open).flags |= DONE;
         } else if ((*open).flags & HAS_PREV) != 0u && (((*open).prev_v < 0.0) != (vi < 0.0)) {
-            out = iso_hit(part, ray, (*open).prev_t, (*open).prev_v, t, out);
+            out = iso_hit(*part, ray, (*open).prev_t, (*open).prev_v, t, out);
             (*open).flags |= DONE;
         } else {
             (*open).prev_t = t;
@@ -284,9 +296,18 @@ fn two_level_sample(r: Region, open: ptr<function, Open>, q: vec3<f32>, ratio: f
     }
 #endif
 #ifdef HAS_DVR
-    out = dvr_sample(part, q, ratio, ray, t, out);
+    out = dvr_classified(*part, q, v, classify(*part, v, scene.lut_atlas_width), ratio, ray, t, out);
 #endif
     return out;
+}
+
+// The record of the open segment's part (a blank one before the first segment).
+fn open_part(r: Region, o: Open) -> Region {
+    var part: Region;
+    if o.part < r.objects.y {
+        part = regions[r.objects.x + o.part];
+    }
+    return part;
 }
 #endif
 
@@ -396,7 +417,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #ifdef HAS_TWO_LEVEL
                 if r.mode == MODE_TWO_LEVEL {
                     var o = opens[s];
-                    acc = close_segment(r, &o, acc);
+                    acc = close_segment(r, open_part(r, o), &o, acc);
                     opens[s] = o;
                 }
 #endif
@@ -428,11 +449,35 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #ifdef HAS_TWO_LEVEL
             if r.mode == MODE_TWO_LEVEL {
                 var o = opens[s];
+                let labels = regions[r.objects.z];
+                var part = open_part(r, o);
+                let occupancy = skip && (r.flags & REGION_OCCUPANCY) != 0u;
                 for (var two_level_steps = 0u; two_level_steps < scene.max_steps; two_level_steps++) {
                     if kk > k_end || acc.a >= stop {
                         break;
                     }
-                    acc = two_level_sample(r, &o, segment_point(g, kk), ratios[s], ray, segment_t(g, kk), acc);
+                    // Bricks where no part draws (twolevel::Segmentation::brick_occupancy)
+                    // are crossed as DVR crosses empty bricks; the open segment ends there.
+                    if occupancy {
+                        let before_skip = kk;
+                        for (var skip_steps = 0u; skip_steps < scene.max_steps; skip_steps++) {
+                            if kk > k_end {
+                                break;
+                            }
+                            let q = segment_point(g, kk);
+                            if !at_full_resolution() || brick_occupied(r, q) {
+                                break;
+                            }
+                            kk = past_brick(r, g, q, kk);
+                        }
+                        if kk > before_skip {
+                            acc = end_segment(r, part, &o, acc);
+                        }
+                        if kk > k_end {
+                            break;
+                        }
+                    }
+                    acc = two_level_sample(r, labels, &part, &o, segment_point(g, kk), ratios[s], ray, segment_t(g, kk), acc);
                     kk += 1.0;
                 }
                 opens[s] = o;
@@ -550,7 +595,12 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #ifdef HAS_TWO_LEVEL
             if r.mode == MODE_TWO_LEVEL {
                 var o = opens[s];
-                acc = two_level_sample(r, &o, q, ratios[s], ray, t, acc);
+                var part = open_part(r, o);
+                if !skip || (r.flags & REGION_OCCUPANCY) == 0u || !at_full_resolution() || brick_occupied(r, q) {
+                    acc = two_level_sample(r, regions[r.objects.z], &part, &o, q, ratios[s], ray, t, acc);
+                } else {
+                    acc = end_segment(r, part, &o, acc);
+                }
                 opens[s] = o;
                 continue;
             }
@@ -598,7 +648,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #ifdef HAS_TWO_LEVEL
         if (state[s] & DONE) == 0u && r.mode == MODE_TWO_LEVEL && acc.a < stop {
             var o = opens[s];
-            acc = close_segment(r, &o, acc);
+            acc = close_segment(r, open_part(r, o), &o, acc);
         }
 #endif
     }

@@ -284,3 +284,40 @@ fn segmentations_are_saved_and_load_back() {
     assert!(!b.rest_visible);
     assert_eq!(b.objects[0].labels, vec![focal::volume::phantom::head::label::SKULL as u32]);
 }
+
+#[test]
+fn empty_bricks_are_those_where_no_part_draws() {
+    let (data, labels) = phantom();
+    let a = Appearance::new(Mode::Dvr, ramp());
+    let plain = a.brick_occupancy(&data).unwrap();
+    let alike = vec![Object::new("ball", vec![1], a.clone()), Object::new("cube", vec![2, 3], a.clone())];
+    let segmented = |objects: Vec<Object>, rest_visible: bool| Appearance {
+        segmentation: Some(Segmentation { table: None, labels: labels.clone(), objects, rest_visible }),
+        ..a.clone()
+    };
+    let count = |o: &[bool]| o.iter().filter(|b| **b).count();
+    // Parts drawn alike: the same bricks as without objects.
+    assert_eq!(segmented(alike.clone(), true).brick_occupancy(&data).unwrap(), plain);
+    // The rest hidden, the ball hidden too: only bricks with the cube's labels remain.
+    let mut hidden = alike.clone();
+    hidden[0].visible = false;
+    let cube_only = segmented(hidden.clone(), false).brick_occupancy(&data).unwrap();
+    let bricks = data.bricks();
+    let at = |x: f32, y: f32, z: f32| bricks.index(bricks.brick_at(Vec3::new(x, y, z) + 15.5));
+    assert!(cube_only[at(8.0, 0.0, 0.0)] && !cube_only[at(-8.0, 0.0, 0.0)]);
+    assert!(count(&cube_only) < count(&plain), "{} vs {}", count(&cube_only), count(&plain));
+    // With the rest shown, the ball's bricks stay: their label-0 voxels are the rest,
+    // and the rest's transfer function is not zero over the brick's values.
+    assert!(segmented(hidden, true).brick_occupancy(&data).unwrap()[at(-8.0, 0.0, 0.0)]);
+    // A MIP object looks at every sample: a brick holding its labels is kept even where
+    // its transfer function is zero over the brick's values; a DVR object is not.
+    let mut high = ramp();
+    high.opacity = vec![OpacityPoint(0.0, 0.0), OpacityPoint(250.0, 0.0), OpacityPoint(255.0, 1.0)];
+    let with = |mode: Mode| {
+        let o = Object::new("cube", vec![2, 3], Appearance::new(mode, high.clone()));
+        segmented(vec![o], false).brick_occupancy(&data).unwrap()
+    };
+    let (mip, dvr) = (with(Mode::Mip), with(Mode::Dvr));
+    assert!(mip[at(8.0, 0.0, 0.0)] && !dvr[at(8.0, 0.0, 0.0)]);
+    assert_eq!(count(&dvr), 0);
+}

@@ -9,7 +9,8 @@
 //! overhead; then the feature lens on the labelled head while the camera orbits, its
 //! silhouette found each frame on the GPU or on the CPU; goal: at most 25 %),
 //! `--context` (context-preserving rendering against DVR on the engine: at κt = 0, the
-//! same picture, the cost of evaluating equation 5; goal: at most 5 %). Each line
+//! same picture, the cost of evaluating equation 5; goal: at most 5 %), `--twolevel`
+//! (two-level rendering of the head CT split by its labels against no objects). Each line
 //! ends with the ratio against its group's baseline; `--json` prints the same as JSON.
 
 use std::sync::Arc;
@@ -25,6 +26,7 @@ use focal::region::{Appearance, Lookup, Mode, View};
 use focal::render::VolumeView;
 use focal::render::headless::Offscreen;
 use focal::transfer::{LabelTransfer, presets};
+use focal::twolevel::{Object, Segmentation};
 use focal::volume::Volume;
 use focal::volume::phantom::{self, Phantom};
 use serde_json::json;
@@ -55,6 +57,9 @@ pub struct BenchArgs {
     /// Only the context-preserving group.
     #[arg(long)]
     context: bool,
+    /// Only the two-level group.
+    #[arg(long)]
+    twolevel: bool,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -213,7 +218,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         .split_once('x')
         .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
         .ok_or_else(|| format!("size '{}' is not WIDTHxHEIGHT", args.size))?;
-    let all = !(args.skipping || args.termination || args.modes || args.lenses || args.context);
+    let all = !(args.skipping || args.termination || args.modes || args.lenses || args.context || args.twolevel);
     let off = Offscreen::new(w, h, |app| {
         app.add_plugins(FocalPlugins);
     })?;
@@ -287,6 +292,41 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let (ms, images) = bench.interleaved_appearances(engine, &appearances, still)?;
         let note = format!("κt 0 differs from DVR by at most {} levels; goal ≤ ×1.05", difference(&images[0], &images[1]));
         push_group(&mut rows, "context", &names, &ms, "engine phantom", &note);
+    }
+
+    if all || args.twolevel {
+        // Two-level rendering on the head CT split by its labels, against the rest's
+        // appearance alone. With every object drawn like the rest the picture is the
+        // same: the cost of finding each sample's object (a label fetch, a table
+        // lookup). Then arteries DVR, skull MIP, ventricles X-ray over a
+        // context-preserving rest.
+        let head = focal::volume::phantom::head::generate(args.resolution)?;
+        let ct = Arc::new(head.ct);
+        let labels = Arc::new(head.labels.volume);
+        let rest = Appearance {
+            context: ContextParams { kappa_t: 3.0, ..Default::default() },
+            ..Appearance::new(Mode::Context, presets::builtin("ct_skin_bone")?)
+        };
+        let segmented = |objects: Vec<Object>| Appearance {
+            segmentation: Some(Segmentation { labels: labels.clone(), table: None, objects, rest_visible: true }),
+            ..rest.clone()
+        };
+        use focal::volume::phantom::head::label;
+        let alike = ["skull", "arteries"]
+            .iter()
+            .zip([label::SKULL, label::ARTERIES])
+            .map(|(n, l)| Object::new(*n, vec![l as u32], rest.clone()))
+            .collect();
+        let objects = vec![
+            Object::new("arteries", vec![label::ARTERIES as u32], Appearance::new(Mode::Dvr, presets::builtin("ct_vessels")?)),
+            Object::new("skull", vec![label::SKULL as u32], Appearance::new(Mode::Mip, presets::builtin("grayscale_ramp")?)),
+            Object::new("ventricles", vec![label::VENTRICLES as u32], Appearance::new(Mode::XRay, presets::builtin("grayscale_ramp")?)),
+        ];
+        let names = ["context (no objects)", "two-level, objects alike", "two-level, dvr + mip + xray"];
+        let appearances = [rest.clone(), segmented(alike), segmented(objects)];
+        let (ms, images) = bench.interleaved_appearances(ct, &appearances, still)?;
+        let note = format!("objects alike differ from no objects by at most {} levels", difference(&images[0], &images[1]));
+        push_group(&mut rows, "twolevel", &names, &ms, "head phantom", &note);
     }
 
     if all || args.lenses {

@@ -134,12 +134,18 @@ impl Appearance {
     /// Which bricks of `volume` can contribute under this appearance, for the modes that
     /// composite samples (DVR, gradient-modulated DVR, label volumes): a brick whose code
     /// range maps only to zero opacity adds nothing. `None` for modes that look at every
-    /// sample (projections, iso-surfaces).
+    /// sample (projections, iso-surfaces). Segmented volumes: see
+    /// [`Segmentation::brick_occupancy`].
     pub fn brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {
-        // Segmented volumes: every sample decides which object a segment belongs to.
-        if self.segmentation.is_some() {
-            return None;
+        match &self.segmentation {
+            Some(seg) => Some(seg.brick_occupancy(volume, self.own_brick_occupancy(volume))),
+            None => self.own_brick_occupancy(volume),
         }
+    }
+
+    /// [`Self::brick_occupancy`] of this appearance's own mode and lookup (for a
+    /// segmented volume: of the rest).
+    fn own_brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {
         let bricks = volume.bricks();
         match &self.lookup {
             Lookup::Transfer(tf) if matches!(self.mode, Mode::Dvr | Mode::GradientDvr | Mode::Context) => {

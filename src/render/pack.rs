@@ -186,7 +186,6 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         let mut region = pack_region(p, &levels, out.brick_atlas.offsets[slots[0]], &mut out);
         if p.objects.is_some() {
             region.mode = mode::TWO_LEVEL;
-            region.flags &= !region_flags::OCCUPANCY;
             segmented.push((out.regions.len(), p, slots));
         }
         out.regions.push(region);

@@ -149,6 +149,81 @@ impl Segmentation {
         ObjectTable { candidates, ranges }
     }
 
+    /// Which bricks of `data` can contribute, given `rest` (the occupancy of the rest's
+    /// own appearance, `None`: every brick). A brick is empty when every part its
+    /// samples can fall into draws nothing there: hidden, or DVR-like with zero
+    /// opacity over the brick's values. The parts come from the label voxels nearest
+    /// to any point of the brick (all candidate objects of their codes, and the rest
+    /// where a code has no object or an object with a value range). Projection and
+    /// iso-surface parts look at every sample, so a brick where one can occur is kept;
+    /// skipping a brick therefore never cuts a segment that would have emitted
+    /// something (the renderers end the open segment where they skip).
+    pub fn brick_occupancy(&self, data: &Volume, rest: Option<Vec<bool>>) -> Vec<bool> {
+        let bricks = data.bricks();
+        let table = self.table(data);
+        let rest_bit = 1u128 << MAX_OBJECTS;
+        let masks: Vec<u128> = table
+            .candidates
+            .iter()
+            .map(|c| {
+                let listed = c.iter().take_while(|&&k| k > 0).map(|&k| k as usize - 1);
+                let mut m = listed.clone().fold(0u128, |m, k| m | 1 << k);
+                if m == 0 || listed.into_iter().any(|k| self.objects[k].values.is_some()) {
+                    m |= rest_bit;
+                }
+                m
+            })
+            .collect();
+        // Per part: drawn at all, and its own occupancy.
+        let parts: Vec<(bool, Option<Vec<bool>>)> = self
+            .objects
+            .iter()
+            .map(|o| (o.visible, o.visible.then(|| o.appearance.brick_occupancy(data)).flatten()))
+            .chain(std::iter::once((self.rest_visible, rest)))
+            .collect();
+        let to_label = self.data_to_label(&data.grid);
+        let ldims = self.labels.dims();
+        let mut out = vec![false; bricks.len()];
+        for z in 0..bricks.dims.z {
+            for y in 0..bricks.dims.y {
+                for x in 0..bricks.dims.x {
+                    let b = glam::UVec3::new(x, y, z);
+                    let (lo, hi) = bricks.brick_bounds(b);
+                    // Nearest label voxels of the brick's box (clamped as the samplers clamp).
+                    let corners = (0..8).map(|c| {
+                        let p = glam::Vec3::new(
+                            if c & 1 == 0 { lo.x } else { hi.x },
+                            if c & 2 == 0 { lo.y } else { hi.y },
+                            if c & 4 == 0 { lo.z } else { hi.z },
+                        );
+                        to_label.transform_point3(p)
+                    });
+                    let (mut a, mut z1) = (glam::Vec3::splat(f32::INFINITY), glam::Vec3::splat(f32::NEG_INFINITY));
+                    for c in corners {
+                        a = a.min(c);
+                        z1 = z1.max(c);
+                    }
+                    let first = (a + 0.5).floor().max(glam::Vec3::ZERO).as_uvec3().min(ldims - 1);
+                    let last = (z1 + 0.5).floor().max(glam::Vec3::ZERO).as_uvec3().min(ldims - 1);
+                    let mut mask = 0u128;
+                    for k in first.z..=last.z {
+                        for j in first.y..=last.y {
+                            for i in first.x..=last.x {
+                                mask |= masks.get(self.labels.code(i, j, k) as usize).copied().unwrap_or(rest_bit);
+                            }
+                        }
+                    }
+                    let index = bricks.index(b);
+                    out[index] = parts.iter().enumerate().any(|(p, (shown, occ))| {
+                        let bit = if p == self.objects.len() { rest_bit } else { 1 << p };
+                        mask & bit != 0 && *shown && occ.as_ref().is_none_or(|o| o[index])
+                    });
+                }
+            }
+        }
+        out
+    }
+
     /// The modes the objects draw with (for the shader's feature list).
     pub fn modes(&self) -> impl Iterator<Item = Mode> + '_ {
         self.objects.iter().filter(|o| o.visible).map(|o| o.appearance.mode)
