@@ -54,8 +54,9 @@ pub fn panel(ui: &mut Ui, data: &Volume, segmentation: &mut Option<Segmentation>
     if let Some(code) = sel.picked {
         picked_label(ui, data, seg, code, sel.editing);
     } else {
-        ui.label(RichText::new("double-click the view to pick a label").small().weak());
+        ui.label(RichText::new("double-click the view to pick a label, or choose one below").small().weak());
     }
+    egui::CollapsingHeader::new("labels").default_open(false).show(ui, |ui| label_list(ui, data, seg, sel.editing));
     let mut remove = None;
     for (k, o) in seg.objects.iter_mut().enumerate() {
         ui.horizontal(|ui| {
@@ -111,6 +112,39 @@ fn picked_label(ui: &mut Ui, data: &Volume, seg: &mut Segmentation, code: u32, e
             && ui.button(format!("add to '{}'", seg.objects[k].name)).clicked()
         {
             try_edit(ui, seg, |s| s.objects[k].labels.push(code));
+        }
+    });
+}
+
+/// Every label of the table with the object holding it; a button makes an object of a
+/// label in no object.
+fn label_list(ui: &mut Ui, data: &Volume, seg: &mut Segmentation, editing: &mut Option<usize>) {
+    let Some(table) = seg.table.clone() else {
+        ui.label(RichText::new("the label volume has no table of names").small().weak());
+        return;
+    };
+    egui::ScrollArea::vertical().max_height(200.0).id_salt("object labels").show(ui, |ui| {
+        for (&code, label) in &table.labels {
+            ui.horizontal(|ui| {
+                let [r, g, b] = label.color;
+                ui.label(RichText::new("■").color(Color32::from_rgb(r, g, b)));
+                ui.label(format!("{} ({code})", label.name));
+                match seg.object_of_label(code) {
+                    Some(k) => {
+                        ui.label(RichText::new(format!("in '{}'", seg.objects[k].name)).small().weak());
+                    }
+                    None => {
+                        if ui.small_button("+ object").clicked()
+                            && let Ok(tf) = presets::default_for(data)
+                            && try_edit(ui, seg, |s| {
+                                s.objects.push(Object::new(label.name.clone(), vec![code], Appearance::new(Mode::Dvr, tf)))
+                            })
+                        {
+                            *editing = Some(seg.objects.len() - 1);
+                        }
+                    }
+                }
+            });
         }
     });
 }
