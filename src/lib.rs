@@ -2,7 +2,7 @@
 //!
 //! The crate is organised by technique (see `../shared/DESIGN.md` and the README):
 //! [`volume`] holds the data model, readers and phantoms; [`transfer`] the transfer
-//! functions; [`region`] the geometry every renderer shares; [`lens`] the magic volume lenses; [`context`] context-preserving rendering; [`clip`] clip planes and boxes; [`twolevel`] two-level rendering of segmented data; [`reference`] the CPU
+//! functions; [`region`] the geometry every renderer shares; [`lens`] the magic volume lenses; [`context`] context-preserving rendering; [`clip`] clip planes and boxes; [`twolevel`] two-level rendering of segmented data; [`windows`] volumetric windows; [`reference`] the CPU
 //! reference renderer; [`dataset`] the dataset entities that become regions; [`render`]
 //! the GPU ray caster that packs and draws them; [`scene`] scene files; [`ui`] the
 //! desktop app.
@@ -19,6 +19,7 @@ pub mod transfer;
 pub mod twolevel;
 pub mod ui;
 pub mod volume;
+pub mod windows;
 
 use bevy::app::{PluginGroup, PluginGroupBuilder};
 
@@ -28,7 +29,7 @@ pub struct FocalCorePlugins;
 
 impl PluginGroup for FocalCorePlugins {
     fn build(self) -> PluginGroupBuilder {
-        PluginGroupBuilder::start::<Self>().add(dataset::DatasetPlugin).add(lens::LensPlugin)
+        PluginGroupBuilder::start::<Self>().add(dataset::DatasetPlugin).add(lens::LensPlugin).add(windows::VolumeWindowPlugin)
     }
 }
 

@@ -48,6 +48,8 @@ pub struct GpuVolume {
 #[derive(Resource, Clone, Default)]
 pub struct SceneRegions {
     pub scene: RenderScene,
+    /// The dataset entity of each of `scene.volumes`.
+    pub datasets: Vec<Entity>,
 }
 
 /// Lighting of the scene.
@@ -65,12 +67,13 @@ pub enum RegionSystems {
 
 /// Collects one region per visible dataset.
 pub fn collect_regions(
-    datasets: Query<(&Dataset, Option<&GpuVolume>, &GlobalTransform)>,
+    datasets: Query<(Entity, &Dataset, Option<&GpuVolume>, &GlobalTransform)>,
     light: Res<SceneLight>,
     mut out: ResMut<SceneRegions>,
 ) {
     let mut scene = RenderScene { light: light.0, ..Default::default() };
-    for (d, gpu, transform) in &datasets {
+    let mut entities = Vec::new();
+    for (entity, d, gpu, transform) in &datasets {
         if !d.visible {
             continue;
         }
@@ -79,9 +82,13 @@ pub fn collect_regions(
         scene.regions.push(Region::dataset(&volume.grid, transform.affine(), &d.clip, index));
         scene.volumes.push(volume);
         scene.appearances.push(d.appearance.clone());
+        entities.push(entity);
     }
     if out.scene != scene {
         out.scene = scene;
+    }
+    if out.datasets != entities {
+        out.datasets = entities;
     }
 }
 

@@ -1,0 +1,197 @@
+//! Oriented boxes (windows and source boxes) and cutting a box out of a convex region.
+//!
+//! A box is a centre, a rotation and half extents; its local coordinates run over
+//! `[-1, 1]³`, so the map between two boxes is "same local coordinates"
+//! ([`crate::windows::mapping`]).
+//!
+//! Cutting a box `B` (half-spaces `h₁ … h₆`) out of a convex region `R` leaves a
+//! non-convex set, split here into at most six convex pieces that do not overlap:
+//! `R ∖ B = ⋃ᵢ R ∩ h₁ ∩ … ∩ hᵢ₋₁ ∩ ¬hᵢ`. Pieces that are empty (no vertex) are dropped,
+//! and a region the box does not touch is returned whole.
+
+use glam::{Affine3A, Mat3, Quat, Vec3};
+
+use crate::region::Plane;
+
+/// A box in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrientedBox {
+    pub center: Vec3,
+    pub rotation: Quat,
+    /// Half the extent along each of the box's own axes.
+    pub half: Vec3,
+}
+
+impl OrientedBox {
+    /// The axis-aligned box `[lo, hi]`.
+    pub fn aligned(lo: Vec3, hi: Vec3) -> OrientedBox {
+        OrientedBox { center: (lo + hi) * 0.5, rotation: Quat::IDENTITY, half: (hi - lo).abs() * 0.5 }
+    }
+
+    /// Local coordinates (`[-1, 1]³` inside) → world.
+    pub fn to_world(&self) -> Affine3A {
+        Affine3A::from_mat3_translation(Mat3::from_quat(self.rotation) * Mat3::from_diagonal(self.half), self.center)
+    }
+
+    /// World → local coordinates (the inverse of [`Self::to_world`]; a flat box maps
+    /// everything to its plane).
+    pub fn to_local(&self) -> Affine3A {
+        let inv_half = Vec3::select(self.half.cmpgt(Vec3::splat(1e-12)), self.half.recip(), Vec3::ZERO);
+        let r = Mat3::from_quat(self.rotation.inverse());
+        Affine3A::from_mat3_translation(Mat3::from_diagonal(inv_half) * r, -(Mat3::from_diagonal(inv_half) * (r * self.center)))
+    }
+
+    /// The six half-spaces whose intersection is the box (normals point out).
+    pub fn planes(&self) -> Vec<Plane> {
+        let axes = Mat3::from_quat(self.rotation);
+        (0..3)
+            .flat_map(|a| {
+                let n = axes.col(a);
+                [Plane::through(self.center + n * self.half[a], n), Plane::through(self.center - n * self.half[a], -n)]
+            })
+            .collect()
+    }
+
+    /// Whether a world point lies inside (boundary included).
+    pub fn contains(&self, p: Vec3) -> bool {
+        let l = self.to_local().transform_point3(p);
+        l.abs().max_element() <= 1.0 + 1e-5
+    }
+
+    /// The eight corners.
+    pub fn corners(&self) -> [Vec3; 8] {
+        let m = self.to_world();
+        std::array::from_fn(|c| {
+            m.transform_point3(Vec3::new(
+                if c & 1 == 0 { -1.0 } else { 1.0 },
+                if c & 2 == 0 { -1.0 } else { 1.0 },
+                if c & 4 == 0 { -1.0 } else { 1.0 },
+            ))
+        })
+    }
+}
+
+/// The vertices of the convex polyhedron `planes` (points where three planes meet and
+/// no plane excludes); empty when the polyhedron has no volume or is unbounded in a
+/// way no three planes close.
+pub fn vertices(planes: &[Plane]) -> Vec<Vec3> {
+    let mut out = Vec::new();
+    let n = planes.len();
+    for i in 0..n {
+        for j in i + 1..n {
+            for k in j + 1..n {
+                let (a, b, c) = (planes[i], planes[j], planes[k]);
+                let m = Mat3::from_cols(a.normal, b.normal, c.normal).transpose();
+                let det = m.determinant();
+                if det.abs() < 1e-9 {
+                    continue;
+                }
+                let p = m.inverse() * Vec3::new(a.offset, b.offset, c.offset);
+                if planes.iter().all(|pl| pl.distance(p) <= 1e-4 * (1.0 + p.length())) {
+                    out.push(p);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Whether the convex polyhedron `planes` has volume (its vertices do not all lie in
+/// one plane).
+pub fn has_volume(planes: &[Plane]) -> bool {
+    let v = vertices(planes);
+    if v.len() < 4 {
+        return false;
+    }
+    let (lo, hi) = v.iter().fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), p| (a.min(*p), b.max(*p)));
+    let scale = (hi - lo).max_element().max(1e-6);
+    // Some vertex lies off the plane of three others by a noticeable fraction.
+    let (a, b, c) = (v[0], v[1], v[2]);
+    let mut normal = (b - a).cross(c - a);
+    if normal.length() < 1e-9 * scale * scale {
+        // The first three are collinear: find a non-collinear third.
+        normal = v.iter().map(|p| (b - a).cross(*p - a)).max_by(|x, y| x.length().total_cmp(&y.length())).unwrap_or(Vec3::ZERO);
+    }
+    let len = normal.length();
+    len > 0.0 && v.iter().any(|p| ((*p - a).dot(normal) / len).abs() > 1e-4 * scale)
+}
+
+/// Convex pieces of `region ∖ cut` (see the module doc), each a list of planes.
+pub fn subtract(region: &[Plane], cut: &OrientedBox) -> Vec<Vec<Plane>> {
+    let mut with_box = region.to_vec();
+    with_box.extend(cut.planes());
+    if !has_volume(&with_box) {
+        return vec![region.to_vec()];
+    }
+    let mut pieces = Vec::new();
+    let mut inside: Vec<Plane> = region.to_vec();
+    for h in cut.planes() {
+        let mut piece = inside.clone();
+        piece.push(h.flipped());
+        if has_volume(&piece) {
+            pieces.push(piece);
+        }
+        inside.push(h);
+    }
+    pieces
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_cube() -> Vec<Plane> {
+        OrientedBox::aligned(Vec3::splat(-1.0), Vec3::splat(1.0)).planes()
+    }
+
+    #[test]
+    fn local_and_world_coordinates_invert() {
+        let b = OrientedBox { center: Vec3::new(1.0, 2.0, 3.0), rotation: Quat::from_rotation_z(0.7), half: Vec3::new(2.0, 1.0, 0.5) };
+        let p = Vec3::new(0.3, -0.8, 0.9);
+        assert!((b.to_local().transform_point3(b.to_world().transform_point3(p)) - p).length() < 1e-5);
+        // The local x axis runs along the rotated x axis, scaled by the half extent.
+        let x = b.to_world().transform_point3(Vec3::X) - b.center;
+        assert!((x - Vec3::new(0.7f32.cos(), 0.7f32.sin(), 0.0) * 2.0).length() < 1e-5);
+        assert!(b.contains(b.center + Vec3::new(0.0, 0.0, 0.49)) && !b.contains(b.center + Vec3::new(0.0, 0.0, 0.51)));
+        assert!(b.corners().iter().all(|c| b.contains(*c)));
+    }
+
+    #[test]
+    fn a_cube_has_eight_vertices() {
+        assert_eq!(vertices(&unit_cube()).len(), 8);
+        assert!(has_volume(&unit_cube()));
+        // Two opposite half-spaces that do not overlap: empty.
+        let empty = [Plane::through(Vec3::ZERO, Vec3::X), Plane::through(Vec3::X, -Vec3::X)];
+        let mut planes = unit_cube();
+        planes.extend(empty);
+        assert!(!has_volume(&planes));
+    }
+
+    #[test]
+    fn cutting_a_box_out_leaves_disjoint_pieces_covering_the_rest() {
+        let region = unit_cube();
+        let cut = OrientedBox { center: Vec3::new(0.2, 0.0, 0.0), rotation: Quat::from_rotation_y(0.3), half: Vec3::splat(0.4) };
+        let pieces = subtract(&region, &cut);
+        assert!(!pieces.is_empty() && pieces.len() <= 6);
+        // Every point of a grid over the region lies in exactly one piece, or in the box.
+        let inside = |planes: &[Plane], p: Vec3| planes.iter().all(|pl| pl.distance(p) < 0.0);
+        let mut n = 0;
+        for i in 0..11 {
+            for j in 0..11 {
+                for k in 0..11 {
+                    let p = Vec3::new(i as f32, j as f32, k as f32) * 0.19 - 0.95 + Vec3::splat(0.003);
+                    let count = pieces.iter().filter(|pl| inside(pl, p)).count();
+                    let in_box = cut.to_local().transform_point3(p).abs().max_element() < 1.0;
+                    assert_eq!(count, usize::from(!in_box), "{p}: {count} pieces, in box {in_box}");
+                    n += usize::from(in_box);
+                }
+            }
+        }
+        assert!(n > 20, "the grid barely met the box: {n}");
+        // A box away from the region leaves it whole.
+        let far = OrientedBox::aligned(Vec3::splat(5.0), Vec3::splat(6.0));
+        assert_eq!(subtract(&region, &far), vec![region.clone()]);
+        // A box around the whole region leaves nothing.
+        assert!(subtract(&region, &OrientedBox::aligned(Vec3::splat(-2.0), Vec3::splat(2.0))).is_empty());
+    }
+}
