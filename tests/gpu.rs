@@ -18,6 +18,8 @@ mod context;
 mod lenses;
 #[path = "gpu/twolevel.rs"]
 mod twolevel;
+#[path = "gpu/windows.rs"]
+mod windows;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
@@ -44,7 +46,9 @@ impl Gpu {
         let world = self.off.world_mut();
         let datasets: Vec<Entity> = world.query_filtered::<Entity, With<Dataset>>().iter(world).collect();
         let meshes: Vec<Entity> = world.query_filtered::<Entity, With<Mesh3d>>().iter(world).collect();
-        for e in datasets.into_iter().chain(meshes) {
+        let windows: Vec<Entity> = world.query_filtered::<Entity, With<focal::windows::VolumeWindow>>().iter(world).collect();
+        let sources: Vec<Entity> = world.query_filtered::<Entity, With<focal::windows::SourceBox>>().iter(world).collect();
+        for e in datasets.into_iter().chain(meshes).chain(windows).chain(sources) {
             world.despawn(e);
         }
         self.off.set_view(VolumeView { jitter: false, ..Default::default() });
@@ -330,7 +334,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [(&str, fn(&mut Gpu)); 19] = [
+    let tests: [(&str, fn(&mut Gpu)); 21] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -350,6 +354,8 @@ fn main() {
         ("a_clip_box_inside_the_engine_makes_minip_useful", clip::a_clip_box_inside_the_engine_makes_minip_useful),
         ("two_level_matches_the_reference", twolevel::two_level_matches_the_reference),
         ("overlapping_two_level_regions_match_the_reference", twolevel::overlapping_two_level_regions_match_the_reference),
+        ("a_clip_window_shows_nothing_of_the_main_view_inside", windows::a_clip_window_shows_nothing_of_the_main_view_inside),
+        ("a_magnifying_window_enlarges_its_source", windows::a_magnifying_window_enlarges_its_source),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

@@ -12,12 +12,13 @@
 //! (a world-in-miniature). A clip window cuts its box out of the datasets' regions,
 //! which splits each into convex pieces ([`boxes::subtract`]).
 //!
-//! [`boxes`] and [`mapping`] are pure math; [`systems`] moves attached windows and
-//! turns windows into regions every frame.
+//! [`boxes`], [`mapping`] and [`regions`] are pure; [`systems`] moves attached windows
+//! and places them every frame.
 
 pub mod boxes;
 pub mod components;
 pub mod mapping;
+pub mod regions;
 pub mod systems;
 
 use bevy::prelude::*;

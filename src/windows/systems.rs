@@ -1,23 +1,16 @@
-//! Window systems: attachments move windows; every frame each window becomes regions
-//! (one per content, its box mapped onto its source) and clip windows cut their box out
-//! of the datasets' regions.
-//!
-//! Overlapping windows: each window's regions cover its own box, so where two windows
-//! overlap both contents show, composited sample by sample (region order: windows in
-//! entity order). A clip window cuts the main view's datasets only, never another
-//! window's contents; where clip windows overlap, the datasets are cut by the union of
-//! the boxes.
+//! Window systems: attachments move windows; every frame the windows are placed (boxes,
+//! sources, orientation coupling) and become regions ([`super::regions`]), in entity
+//! order.
 
 use std::collections::HashMap;
 
 use bevy::prelude::*;
-use glam::Affine3A;
 
-use super::boxes::{OrientedBox, subtract};
-use super::components::{Attachment, Fit, Orientation, Pointer3d, Source, SourceBox, Viewer, VolumeWindow};
-use super::mapping::{coupled_rotation, fit, map_rotation, window_to_source};
+use super::boxes::OrientedBox;
+use super::components::{Attachment, Orientation, Pointer3d, Source, SourceBox, Viewer, VolumeWindow};
+use super::mapping::{coupled_rotation, map_rotation};
+use super::regions::{PlacedContent, PlacedWindow, add_windows};
 use crate::dataset::{Dataset, GpuVolume, SceneRegions};
-use crate::region::{Region, box_planes};
 
 /// Keeps user- and dataset-attached windows at their offset from the viewer or the
 /// dataset (room windows stay where they are).
@@ -86,7 +79,7 @@ pub fn window_regions(
     let mut scene = out.scene.clone();
     let mut index = out.datasets.clone();
     let dataset_regions = scene.regions.len();
-    let mut clips = Vec::new();
+    let mut placed = Vec::new();
     for (e, w, _) in &list {
         let Some(&(window, mut source)) = boxes.get(e) else { continue };
         let coupled = match w.automation.orientation {
@@ -97,52 +90,25 @@ pub fn window_regions(
         if let Some(r) = coupled {
             source.rotation = coupled_rotation(window.rotation, r);
         }
-        // Every content's world→voxel map and the corners of its box.
-        let contents: Vec<_> = w
+        let contents = w
             .contents
             .iter()
             .filter_map(|c| {
                 let (d, gpu, g) = datasets.get(c.dataset).ok()?;
                 let volume = gpu.map_or_else(|| d.volume.clone(), |g| g.volume.clone());
-                let world_to_voxel = volume.grid.world_to_index() * g.affine().inverse();
-                Some((c, d, volume, world_to_voxel, g.affine()))
-            })
-            .collect();
-        if let Some(how) = w.automation.fit {
-            let corners: Vec<Vec3> =
-                contents.iter().flat_map(|(_, _, v, _, to_world)| v.grid.corners().map(|p| to_world.transform_point3(p))).collect();
-            source = fit(&window, source.rotation, &corners, how == Fit::Uniform);
-        }
-        let map = window_to_source(&window, &source);
-        for (c, d, volume, world_to_voxel, _) in contents {
-            let volume_index = match index.iter().position(|x| *x == c.dataset) {
-                Some(i) => i,
-                None => {
+                // Windows show their contents whether or not the main view does.
+                let volume_index = index.iter().position(|x| *x == c.dataset).unwrap_or_else(|| {
                     scene.volumes.push(volume.clone());
                     index.push(c.dataset);
                     scene.volumes.len() - 1
-                }
-            };
-            scene.appearances.push(c.appearance.clone().unwrap_or_else(|| d.appearance.clone()));
-            let to_voxel: Affine3A = world_to_voxel * map;
-            let mut planes = window.planes();
-            planes.extend(box_planes(&to_voxel, Vec3::splat(-0.5), volume.dims().as_vec3() - 0.5));
-            scene.regions.push(Region { planes, world_to_voxel: to_voxel, volume: volume_index, appearance: scene.appearances.len() - 1 });
-        }
-        if w.clip {
-            clips.push(window);
-        }
+                });
+                let appearance = c.appearance.clone().unwrap_or_else(|| d.appearance.clone());
+                Some(PlacedContent { volume, volume_index, dataset_to_world: g.affine(), appearance })
+            })
+            .collect();
+        placed.push(PlacedWindow { window, source, fit: w.automation.fit, clip: w.clip, contents });
     }
-    // Clip windows cut the datasets' own regions.
-    let mut cut = Vec::with_capacity(dataset_regions);
-    for r in scene.regions.drain(..dataset_regions) {
-        let mut pieces = vec![r.planes.clone()];
-        for b in &clips {
-            pieces = pieces.iter().flat_map(|p| subtract(p, b)).collect();
-        }
-        cut.extend(pieces.into_iter().map(|planes| Region { planes, ..r.clone() }));
-    }
-    scene.regions.splice(0..0, cut);
+    add_windows(&mut scene, dataset_regions, &placed);
     if out.scene != scene {
         out.scene = scene;
     }

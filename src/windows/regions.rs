@@ -1,0 +1,88 @@
+//! Windows as regions (pure; the ECS system and the scene runner both call it).
+//!
+//! Each content of a window is one region: the window's box, cut to where the content's
+//! data lies, with world → voxel map `V · M` (`V` the dataset's own map, `M` the
+//! window → source map of [`super::mapping`], after the fit automation). A clip window
+//! then cuts its box out of the datasets' own regions (convex pieces,
+//! [`super::boxes::subtract`]); windows never cut each other's contents, so where
+//! windows overlap their contents composite sample by sample, and where clip windows
+//! overlap the datasets are cut by the union of the boxes.
+
+use std::sync::Arc;
+
+use glam::{Affine3A, Vec3};
+
+use super::boxes::{OrientedBox, subtract};
+use super::components::Fit;
+use super::mapping::{fit, window_to_source};
+use crate::region::{Appearance, Region, RenderScene, box_planes};
+use crate::volume::Volume;
+
+/// A window placed in the world, its source box turned by any orientation coupling.
+#[derive(Clone, Debug)]
+pub struct PlacedWindow {
+    pub window: OrientedBox,
+    pub source: OrientedBox,
+    pub fit: Option<Fit>,
+    pub clip: bool,
+    pub contents: Vec<PlacedContent>,
+}
+
+/// One content of a placed window.
+#[derive(Clone, Debug)]
+pub struct PlacedContent {
+    pub volume: Arc<Volume>,
+    /// Index of `volume` in the scene's volumes.
+    pub volume_index: usize,
+    /// The dataset's own frame → world (its transform).
+    pub dataset_to_world: Affine3A,
+    pub appearance: Appearance,
+}
+
+impl PlacedWindow {
+    /// The source box after the fit automation.
+    pub fn fitted_source(&self) -> OrientedBox {
+        match self.fit {
+            Some(how) => {
+                let corners: Vec<Vec3> =
+                    self.contents.iter().flat_map(|c| c.volume.grid.corners().map(|p| c.dataset_to_world.transform_point3(p))).collect();
+                fit(&self.window, self.source.rotation, &corners, how == Fit::Uniform)
+            }
+            None => self.source,
+        }
+    }
+}
+
+/// Adds the windows' regions to `scene`, whose first `dataset_regions` regions are the
+/// datasets' own, and cuts the clip windows out of those.
+pub fn add_windows(scene: &mut RenderScene, dataset_regions: usize, windows: &[PlacedWindow]) {
+    for w in windows {
+        let map = window_to_source(&w.window, &w.fitted_source());
+        for c in &w.contents {
+            scene.appearances.push(c.appearance.clone());
+            let to_voxel = c.volume.grid.world_to_index() * c.dataset_to_world.inverse() * map;
+            let mut planes = w.window.planes();
+            planes.extend(box_planes(&to_voxel, Vec3::splat(-0.5), c.volume.dims().as_vec3() - 0.5));
+            scene.regions.push(Region {
+                planes,
+                world_to_voxel: to_voxel,
+                volume: c.volume_index,
+                appearance: scene.appearances.len() - 1,
+            });
+        }
+    }
+    let clips: Vec<&OrientedBox> = windows.iter().filter(|w| w.clip).map(|w| &w.window).collect();
+    if clips.is_empty() {
+        return;
+    }
+    let n = dataset_regions.min(scene.regions.len());
+    let mut cut = Vec::with_capacity(n);
+    for r in scene.regions.drain(..n) {
+        let mut pieces = vec![r.planes.clone()];
+        for b in &clips {
+            pieces = pieces.iter().flat_map(|p| subtract(p, b)).collect();
+        }
+        cut.extend(pieces.into_iter().map(|planes| Region { planes, ..r.clone() }));
+    }
+    scene.regions.splice(0..0, cut);
+}
