@@ -197,3 +197,70 @@ fn clip_windows_cut_the_datasets_and_show_their_contents() {
     app.update();
     assert_eq!(regions(&app).len(), 2);
 }
+
+/// A phantom scene with one window of each kind.
+const SCENE: &str = r#"(
+    datasets: [
+        (source: Phantom(kind: head, resolution: 32), appearance: (mode: dvr, preset: Some("ct_skin_bone")), translation: (5.0, 0.0, 0.0)),
+        (source: PhantomLabels(resolution: 32), appearance: (labels: Some(())), visible: false),
+    ],
+    camera: Orbit(azimuth_deg: 30.0, elevation_deg: 10.0),
+    pointer: Some((10.0, 20.0, 0.0)),
+    windows: [
+        (center: (0.0, 0.0, 40.0), size: (60.0, 60.0, 60.0), clip: true, contents: [(dataset: 0, appearance: Some((mode: mip)))]),
+        (center: (200.0, 0.0, 0.0), size: (50.0, 50.0, 50.0), source: Box(center: (0.0, 30.0, 0.0), size: (20.0, 20.0, 20.0), rotation_deg: (0.0, 0.0, 30.0)), contents: [(dataset: 1)]),
+        (center: (0.0, -200.0, 0.0), size: (40.0, 40.0, 40.0), source: Pointer(size: (10.0, 10.0, 10.0)), contents: [(dataset: 0)], orientation: Window(1)),
+        (attachment: User, center: (20.0, 20.0, -150.0), size: (12.0, 12.0, 12.0), fit: Some(uniform), orientation: MainView, contents: [(dataset: 0)]),
+        (attachment: Dataset(0), center: (0.0, 0.0, -60.0), rotation_deg: (0.0, 20.0, 0.0), size: (30.0, 30.0, 30.0), contents: [(dataset: 0)]),
+    ],
+)"#;
+
+#[test]
+fn scene_windows_give_the_same_regions_in_the_app_and_the_reference() {
+    use focal::render::headless::camera_bundle;
+    use focal::scene::file::SceneFile;
+    use focal::scene::load::{camera, load_datasets, render_scene_with_windows, visible_bounds, window_appearances};
+    use focal::windows::spec::replace_windows;
+    let base = std::path::Path::new(".");
+    let scene = SceneFile::parse(SCENE, "t").unwrap();
+    scene.validate().unwrap();
+    let datasets = load_datasets(&scene, base).unwrap();
+    let cam = camera(&scene.camera, visible_bounds(&datasets), 1.0);
+    let reference = render_scene_with_windows(&datasets, &scene, &cam, base).unwrap();
+    let mut app = app();
+    let entities: Vec<Entity> =
+        datasets.iter().map(|d| app.world_mut().spawn((d.component(), Transform::from_matrix(Mat4::from(d.transform)))).id()).collect();
+    let viewer = app.world_mut().spawn(camera_bundle(&cam).0).id();
+    let looks = window_appearances(&scene, &datasets, base).unwrap();
+    replace_windows(app.world_mut(), &scene.windows, &looks, &entities, viewer, scene.pointer.map(|(x, y, z)| Vec3::new(x, y, z)));
+    app.update();
+    let ecs = app.world().resource::<SceneRegions>().scene.clone();
+    // The clip window cuts the head into pieces, then the five windows' regions.
+    assert_eq!(ecs.regions.len(), reference.regions.len());
+    assert!(reference.regions.len() > 6);
+    // Same regions, maybe in another order (the app orders windows by entity).
+    let same = |a: &Region, b: &Region| {
+        a.planes.len() == b.planes.len()
+            && a.planes.iter().zip(&b.planes).all(|(p, q)| (p.normal - q.normal).length() < 1e-4 && (p.offset - q.offset).abs() < 1e-2)
+            && Mat4::from(a.world_to_voxel).abs_diff_eq(Mat4::from(b.world_to_voxel), 1e-3)
+            && ecs.appearances[a.appearance] == reference.appearances[b.appearance]
+            && Arc::ptr_eq(&ecs.volumes[a.volume], &reference.volumes[b.volume])
+    };
+    let mut unmatched: Vec<&Region> = reference.regions.iter().collect();
+    for (i, a) in ecs.regions.iter().enumerate() {
+        let k = unmatched.iter().position(|b| same(a, b)).unwrap_or_else(|| panic!("app region {i} is not in the reference: {a:?}"));
+        unmatched.remove(k);
+    }
+}
+
+#[test]
+fn window_specs_with_bad_indices_are_reported() {
+    use focal::scene::file::SceneFile;
+    let bad = |from: &str, to: &str| SceneFile::parse(&SCENE.replace(from, to), "t").unwrap().validate().unwrap_err();
+    assert!(bad("contents: [(dataset: 1)]", "contents: [(dataset: 4)]").contains("window 1: content refers to dataset 4"));
+    assert!(bad("Dataset(0)", "Dataset(3)").contains("window 4: attached to dataset 3"));
+    assert!(bad("Window(1)", "Window(2)").contains("window 2: orientation coupled to window 2"));
+    assert!(bad("size: (12.0, 12.0, 12.0)", "size: (12.0, 0.0, 12.0)").contains("window 3: size"));
+    // A typo in a field is a parse error naming it.
+    assert!(SceneFile::parse(&SCENE.replace("clip: true", "clips: true"), "t").unwrap_err().contains("clips"));
+}

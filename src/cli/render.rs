@@ -165,6 +165,8 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
         datasets: vec![DatasetSpec::of(source, appearance)],
         camera,
         lenses: Vec::new(),
+        windows: Vec::new(),
+        pointer: None,
         frames: Vec::new(),
     })
 }

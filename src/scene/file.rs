@@ -68,6 +68,12 @@ pub struct SceneFile {
     /// Magic lenses on the view, in order (the last on top).
     #[serde(default)]
     pub lenses: Vec<crate::lens::Lens>,
+    /// Volumetric windows.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub windows: Vec<crate::windows::spec::WindowSpec>,
+    /// The 3D pointer's position (world mm), for windows whose source follows it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pointer: Option<(f32, f32, f32)>,
     /// Frames to capture; none means one frame of the scene as it is.
     #[serde(default)]
     pub frames: Vec<FrameSpec>,
@@ -399,6 +405,10 @@ pub enum Change {
     Light(Light),
     /// Replaces the view's lenses.
     Lenses(Vec<crate::lens::Lens>),
+    /// Replaces the volumetric windows.
+    Windows(Vec<crate::windows::spec::WindowSpec>),
+    /// Moves (or removes) the 3D pointer.
+    Pointer(Option<(f32, f32, f32)>),
     /// Replaces the rendering switches.
     Rendering(RenderingSpec),
 }
@@ -412,14 +422,22 @@ impl SceneFile {
     /// Checks what parsing cannot: the lenses' parameters.
     pub fn validate(&self) -> Result<(), String> {
         validate_lenses(&self.lenses)?;
+        self.validate_windows(&self.windows)?;
         for frame in &self.frames {
             for change in &frame.set {
-                if let Change::Lenses(lenses) = change {
-                    validate_lenses(lenses).map_err(|e| format!("frame '{}': {e}", frame.name))?;
-                }
+                let checked = match change {
+                    Change::Lenses(lenses) => validate_lenses(lenses),
+                    Change::Windows(windows) => self.validate_windows(windows),
+                    _ => Ok(()),
+                };
+                checked.map_err(|e| format!("frame '{}': {e}", frame.name))?;
             }
         }
         Ok(())
+    }
+
+    fn validate_windows(&self, windows: &[crate::windows::spec::WindowSpec]) -> Result<(), String> {
+        windows.iter().enumerate().try_for_each(|(i, w)| w.validate(i, self.datasets.len(), windows.len()))
     }
 
     /// Writes RON text.

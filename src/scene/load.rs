@@ -326,6 +326,8 @@ pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneF
         Change::Background(c) => scene.background = *c,
         Change::Light(l) => scene.light = *l,
         Change::Lenses(l) => scene.lenses = l.clone(),
+        Change::Windows(w) => scene.windows = w.clone(),
+        Change::Pointer(p) => scene.pointer = *p,
         Change::Rendering(r) => scene.rendering = *r,
     }
     Ok(())
@@ -348,6 +350,74 @@ pub fn render_scene(datasets: &[LoadedDataset], scene: &SceneFile) -> RenderScen
         out.appearances.push(d.appearance.clone());
     }
     out
+}
+
+/// Each window content's appearance (`None`: the dataset's own).
+pub fn window_appearances(scene: &SceneFile, datasets: &[LoadedDataset], base: &Path) -> Result<Vec<Vec<Option<Appearance>>>, String> {
+    scene
+        .windows
+        .iter()
+        .enumerate()
+        .map(|(i, w)| {
+            w.contents
+                .iter()
+                .map(|c| {
+                    let d = datasets.get(c.dataset).ok_or_else(|| format!("window {i}: content refers to dataset {}", c.dataset))?;
+                    c.appearance
+                        .as_ref()
+                        .map(|a| appearance(a, &d.volume, d.table.as_ref(), base).map_err(|e| format!("window {i}: {e}")))
+                        .transpose()
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// [`render_scene`] with the scene's windows seen from `camera` (the CPU reference's
+/// scene; the app builds the same regions from window entities).
+pub fn render_scene_with_windows(
+    datasets: &[LoadedDataset],
+    scene: &SceneFile,
+    camera: &Camera,
+    base: &Path,
+) -> Result<RenderScene, String> {
+    use crate::windows::regions::{PlacedContent, add_windows};
+    use crate::windows::spec::{placed, placed_boxes};
+    let mut out = render_scene(datasets, scene);
+    if scene.windows.is_empty() {
+        return Ok(out);
+    }
+    let dataset_regions = out.regions.len();
+    // Volume index of each dataset (hidden ones are added when a window shows them).
+    let mut index: Vec<Option<usize>> = Vec::with_capacity(datasets.len());
+    let mut next = 0;
+    for d in datasets {
+        index.push(d.visible.then(|| {
+            next += 1;
+            next - 1
+        }));
+    }
+    let looks = window_appearances(scene, datasets, base)?;
+    let view = crate::render::headless::camera_bundle(camera).0.compute_affine();
+    let transforms: Vec<Affine3A> = datasets.iter().map(|d| d.transform).collect();
+    let boxes = placed_boxes(&scene.windows, view, &transforms, scene.pointer.map(vec3));
+    let mut windows = Vec::new();
+    for ((w, b), looks) in scene.windows.iter().zip(boxes).zip(&looks) {
+        let Some(b) = b else { continue };
+        let mut contents = Vec::new();
+        for (c, look) in w.contents.iter().zip(looks) {
+            let d = &datasets[c.dataset];
+            let volume_index = *index[c.dataset].get_or_insert_with(|| {
+                out.volumes.push(d.volume.clone());
+                out.volumes.len() - 1
+            });
+            let appearance = look.clone().unwrap_or_else(|| d.appearance.clone());
+            contents.push(PlacedContent { volume: d.volume.clone(), volume_index, dataset_to_world: d.transform, appearance });
+        }
+        windows.push(placed(w, b, contents));
+    }
+    add_windows(&mut out, dataset_regions, &windows);
+    Ok(out)
 }
 
 #[cfg(test)]

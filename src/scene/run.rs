@@ -6,13 +6,14 @@ use std::path::{Path, PathBuf};
 use bevy::prelude::*;
 
 use super::file::{FrameSpec, SceneFile};
-use super::load::{LoadedDataset, apply, camera, load_datasets, read_scene, render_scene, visible_bounds};
+use super::load::{LoadedDataset, apply, camera, load_datasets, read_scene, render_scene_with_windows, visible_bounds, window_appearances};
 use crate::FocalPlugins;
 use crate::dataset::{Dataset, SceneLight};
 use crate::lens::systems::replace_lenses;
 use crate::reference::render_lensed;
 use crate::render::VolumeView;
 use crate::render::headless::Offscreen;
+use crate::windows::spec::replace_windows;
 
 /// How to render a scene file.
 #[derive(Clone, Debug, Default)]
@@ -71,8 +72,8 @@ pub fn render_frames(mut scene: SceneFile, base: &Path, options: &RunOptions) ->
         }
         let cam = camera(&camera_spec, bounds, w as f32 / h as f32);
         let image = match &mut gpu {
-            Some(g) => g.capture(&datasets, &scene, &cam)?,
-            None => render_lensed(&render_scene(&datasets, &scene), &cam, &scene.lenses, w, h)?.to_image()?,
+            Some(g) => g.capture(&datasets, &scene, &cam, base)?,
+            None => render_lensed(&render_scene_with_windows(&datasets, &scene, &cam, base)?, &cam, &scene.lenses, w, h)?.to_image()?,
         };
         images.push((frame.name.clone(), image));
     }
@@ -94,12 +95,22 @@ impl GpuRun {
         Ok(GpuRun { off, entities })
     }
 
-    fn capture(&mut self, datasets: &[LoadedDataset], scene: &SceneFile, cam: &crate::region::Camera) -> Result<image::RgbaImage, String> {
+    fn capture(
+        &mut self,
+        datasets: &[LoadedDataset],
+        scene: &SceneFile,
+        cam: &crate::region::Camera,
+        base: &Path,
+    ) -> Result<image::RgbaImage, String> {
         for (e, d) in self.entities.iter().zip(datasets) {
             self.off.world_mut().entity_mut(*e).insert((dataset_component(d), transform(d)));
         }
         self.off.world_mut().insert_resource(SceneLight(scene.light));
         replace_lenses(self.off.world_mut(), &scene.lenses);
+        let looks = window_appearances(scene, datasets, base)?;
+        let camera = self.off.camera();
+        let pointer = scene.pointer.map(|(x, y, z)| Vec3::new(x, y, z));
+        replace_windows(self.off.world_mut(), &scene.windows, &looks, &self.entities, camera, pointer);
         let r = scene.rendering;
         self.off.set_view(VolumeView {
             jitter: r.jitter,

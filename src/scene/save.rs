@@ -151,6 +151,8 @@ pub fn scene_file(
         datasets,
         camera,
         lenses: lenses.to_vec(),
+        windows: Vec::new(),
+        pointer: None,
         frames: Vec::new(),
     }
 }

@@ -19,6 +19,7 @@ pub mod boxes;
 pub mod components;
 pub mod mapping;
 pub mod regions;
+pub mod spec;
 pub mod systems;
 
 use bevy::prelude::*;
