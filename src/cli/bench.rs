@@ -10,7 +10,9 @@
 //! silhouette found each frame on the GPU or on the CPU; goal: at most 25 %),
 //! `--context` (context-preserving rendering against DVR on the engine: at κt = 0, the
 //! same picture, the cost of evaluating equation 5; goal: at most 5 %), `--twolevel`
-//! (two-level rendering of the head CT split by its labels against no objects). Each line
+//! (two-level rendering of the head CT split by its labels against no objects),
+//! `--windows` (one clip window and four windows against none; goals ≤ ×1.10 and
+//! ≤ ×1.33). Each line
 //! ends with the ratio against its group's baseline; `--json` prints the same as JSON.
 
 use std::sync::Arc;
@@ -29,6 +31,7 @@ use focal::transfer::{LabelTransfer, presets};
 use focal::twolevel::{Object, Segmentation};
 use focal::volume::Volume;
 use focal::volume::phantom::{self, Phantom};
+use focal::windows::{Content, Source, SourceBox, VolumeWindow};
 use serde_json::json;
 
 #[derive(Args)]
@@ -60,6 +63,9 @@ pub struct BenchArgs {
     /// Only the two-level group.
     #[arg(long)]
     twolevel: bool,
+    /// Only the volumetric windows group.
+    #[arg(long)]
+    windows: bool,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -218,7 +224,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         .split_once('x')
         .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
         .ok_or_else(|| format!("size '{}' is not WIDTHxHEIGHT", args.size))?;
-    let all = !(args.skipping || args.termination || args.modes || args.lenses || args.context || args.twolevel);
+    let all = !(args.skipping || args.termination || args.modes || args.lenses || args.context || args.twolevel || args.windows);
     let off = Offscreen::new(w, h, |app| {
         app.add_plugins(FocalPlugins);
     })?;
@@ -327,6 +333,46 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let (ms, images) = bench.interleaved_appearances(ct, &appearances, still)?;
         let note = format!("objects alike differ from no objects by at most {} levels", difference(&images[0], &images[1]));
         push_group(&mut rows, "twolevel", &names, &ms, "head phantom", &note);
+    }
+
+    if all || args.windows {
+        // Volumetric windows on the head CT: none, one clip window showing the dataset as
+        // it is (the same picture: the cost of the window's regions alone), one showing
+        // bone (a cutaway: the rays also go deeper), four windows (the clip window and three ×2 windows of
+        // source boxes inside the head). Goals: one clip window ≤ ×1.10 (≥ 90 % of the
+        // frame rate), four ≤ ×1.33 (≥ 75 %).
+        let ct = Arc::new(Phantom::Head.generate(args.resolution)?);
+        let skin = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone")?);
+        let bone = Appearance::new(Mode::Dvr, presets::builtin("ct_bone")?);
+        let names = ["no window", "one clip window, same look", "one clip window, bone", "four windows"];
+        let same = skin.clone();
+        let (ms, images) = bench.interleaved_by(ct, skin, 4, false, |off, i| {
+            let world = off.world_mut();
+            let old: Vec<Entity> = world.query_filtered::<Entity, Or<(With<VolumeWindow>, With<SourceBox>)>>().iter(world).collect();
+            for e in old {
+                world.despawn(e);
+            }
+            let Some(data) = world.query_filtered::<Entity, With<Dataset>>().iter(world).next() else { return };
+            let look = if i == 1 { same.clone() } else { bone.clone() };
+            let content = vec![Content { dataset: data, appearance: Some(look) }];
+            if i >= 1 {
+                let cut = VolumeWindow { clip: true, ..VolumeWindow::new(Vec3::new(80.0, 80.0, 80.0), content.clone()) };
+                world.spawn((cut, Transform::from_xyz(40.0, -40.0, 40.0)));
+            }
+            if i >= 3 {
+                for k in 0..3 {
+                    let x = -80.0 + 60.0 * k as f32;
+                    let source = world.spawn((SourceBox { size: Vec3::splat(20.0) }, Transform::from_xyz(x * 0.3, 0.0, 0.0))).id();
+                    let w = VolumeWindow { source: Source::Box(source), ..VolumeWindow::new(Vec3::splat(40.0), content.clone()) };
+                    world.spawn((w, Transform::from_xyz(x, -60.0, -70.0)));
+                }
+            }
+        })?;
+        let note = format!(
+            "same look differs from no window by at most {} levels; goals: one clip window ≤ ×1.10, four ≤ ×1.33",
+            difference(&images[0], &images[1])
+        );
+        push_group(&mut rows, "windows", &names, &ms, "head phantom", &note);
     }
 
     if all || args.lenses {

@@ -45,6 +45,32 @@ impl Plane {
     }
 }
 
+/// The vertices of the convex polyhedron `planes` (points where three planes meet and
+/// no plane excludes); empty when the polyhedron has no volume or is unbounded in a
+/// way no three planes close.
+pub fn vertices(planes: &[Plane]) -> Vec<Vec3> {
+    use glam::Mat3;
+    let mut out = Vec::new();
+    let n = planes.len();
+    for i in 0..n {
+        for j in i + 1..n {
+            for k in j + 1..n {
+                let (a, b, c) = (planes[i], planes[j], planes[k]);
+                let m = Mat3::from_cols(a.normal, b.normal, c.normal).transpose();
+                let det = m.determinant();
+                if det.abs() < 1e-9 {
+                    continue;
+                }
+                let p = m.inverse() * Vec3::new(a.offset, b.offset, c.offset);
+                if planes.iter().all(|pl| pl.distance(p) <= 1e-4 * (1.0 + p.length())) {
+                    out.push(p);
+                }
+            }
+        }
+    }
+    out
+}
+
 /// Length of the longest diagonal of a box of `dims` voxels under the linear map
 /// `voxel_to_world` (the largest of its four diagonals).
 pub fn longest_diagonal(voxel_to_world: glam::Mat3, dims: Vec3) -> f32 {

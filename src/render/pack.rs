@@ -197,7 +197,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.regions[index].objects = objects;
     }
     out.features = scene_features(&out.regions);
-    out.max_steps = march_bound(&out.regions[..out.region_count as usize]);
+    out.max_steps = march_bound(&out.regions[..out.region_count as usize], union_extent(&prepared));
     // Empty scenes still bind (1-texel) atlases.
     out.atlas.size = out.atlas.size.max(UVec3::ONE);
     out.brick_atlas.size = out.brick_atlas.size.max(UVec3::ONE);
@@ -265,9 +265,13 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
 /// of those regions (`raycast.wgsl`), so it takes at most Σ chord_r / min_r step_r + 1
 /// per region samples. A region lies inside its volume's box, so its chord is at most
 /// the box's longest diagonal; a region's smallest world step is native_step / σ_max of
-/// its world→native map, and the Frobenius norm bounds σ_max from above. The outer loop
-/// also stops once per gap and region boundary: 2 more per region, and 2 spare.
-pub fn march_bound(regions: &[GpuRegion]) -> u32 {
+/// its world→native map, and the Frobenius norm bounds σ_max from above. The samples of
+/// one ray also lie between its first entry and last exit, so `extent` (the diagonal of
+/// the regions' bounding box) bounds the chords' sum too: many small regions (a clip
+/// window cuts a dataset into six pieces) would otherwise multiply the bound, and with it
+/// the time llvmpipe's idle lanes spin. The outer loop also stops once per gap and
+/// region boundary: 2 more per region, and 2 spare.
+pub fn march_bound(regions: &[GpuRegion], extent: Option<f32>) -> u32 {
     let mut chords = 0.0f64;
     let mut step = f64::INFINITY;
     for r in regions {
@@ -277,11 +281,23 @@ pub fn march_bound(regions: &[GpuRegion]) -> u32 {
         chords += diagonal as f64;
         step = step.min(r.native_step as f64 / frobenius.max(1e-12) as f64);
     }
+    if let Some(e) = extent.filter(|e| e.is_finite()) {
+        chords = chords.min(e as f64);
+    }
     if regions.is_empty() || !chords.is_finite() || step.is_nan() || step <= 0.0 {
         return 2;
     }
     let bound = (chords / step).ceil() + 3.0 * regions.len() as f64 + 2.0;
     bound.min(u32::MAX as f64) as u32
+}
+
+/// The diagonal of the bounding box of every region's polyhedron: no ray's samples
+/// span more (`None` when no region has a vertex).
+fn union_extent(prepared: &[PreparedRegion]) -> Option<f32> {
+    let points: Vec<glam::Vec3> = prepared.iter().flat_map(|p| crate::region::vertices(&p.region.planes)).collect();
+    let lo = points.iter().copied().reduce(glam::Vec3::min)?;
+    let hi = points.iter().copied().reduce(glam::Vec3::max)?;
+    Some((hi - lo).length())
 }
 
 /// The shader features a list of regions needs.
@@ -420,15 +436,21 @@ mod tests {
         // 32³ unit voxels, half-voxel steps: diagonal √3·32, smallest step bounded below
         // by 0.5/‖I‖_F = 0.5/√3, so 192 samples, + 3 per region + 2.
         let cube = region(Mat3::IDENTITY, 32.0, 0.5);
-        assert_eq!(march_bound(&[cube]), 197);
+        assert_eq!(march_bound(&[cube], None), 197);
         // Voxels twice as long in x: diagonal |(64, 32, 32)| = 78.38…, same steps:
         // 78.38·2√3 = 271.5 → 272, + 5.
         let long = region(Mat3::from_diagonal(Vec3::new(2.0, 1.0, 1.0)), 32.0, 0.5);
-        assert_eq!(march_bound(&[long]), 277);
+        assert_eq!(march_bound(&[long], None), 277);
         // Two regions: chords add up, the smaller step counts, 3 per region.
         let fine = region(Mat3::IDENTITY, 32.0, 0.25);
-        assert_eq!(march_bound(&[cube, fine]), 384 + 384 + 8);
-        assert_eq!(march_bound(&[]), 2);
+        assert_eq!(march_bound(&[cube, fine], None), 384 + 384 + 8);
+        assert_eq!(march_bound(&[], None), 2);
+        // Pieces of one box (a clip window cut it in two): the chords of a ray through
+        // both add up to at most the box's diagonal, 32√3: 192 samples, + 3 per region + 2.
+        let diagonal = 32.0 * 3f32.sqrt();
+        assert_eq!(march_bound(&[cube, cube], Some(diagonal)), 192 + 6 + 2);
+        // The extent only ever lowers the bound.
+        assert_eq!(march_bound(&[cube], Some(1e6)), 197);
     }
 
     #[test]
@@ -436,7 +458,7 @@ mod tests {
         // A rotated, anisotropic volume: every ray's chord / step (+1) stays below.
         let m = Mat3::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.7) * Mat3::from_diagonal(Vec3::new(0.5, 1.0, 3.0));
         let r = region(m, 40.0, 0.5);
-        let bound = march_bound(&[r]) as f32;
+        let bound = march_bound(&[r], None) as f32;
         let lo = Vec3::splat(-0.5);
         let hi = Vec3::splat(39.5);
         let mut longest = 0.0f32;

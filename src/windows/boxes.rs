@@ -11,7 +11,7 @@
 
 use glam::{Affine3A, Mat3, Quat, Vec3};
 
-use crate::region::Plane;
+use crate::region::{Plane, vertices};
 
 /// A box in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -69,31 +69,6 @@ impl OrientedBox {
             ))
         })
     }
-}
-
-/// The vertices of the convex polyhedron `planes` (points where three planes meet and
-/// no plane excludes); empty when the polyhedron has no volume or is unbounded in a
-/// way no three planes close.
-pub fn vertices(planes: &[Plane]) -> Vec<Vec3> {
-    let mut out = Vec::new();
-    let n = planes.len();
-    for i in 0..n {
-        for j in i + 1..n {
-            for k in j + 1..n {
-                let (a, b, c) = (planes[i], planes[j], planes[k]);
-                let m = Mat3::from_cols(a.normal, b.normal, c.normal).transpose();
-                let det = m.determinant();
-                if det.abs() < 1e-9 {
-                    continue;
-                }
-                let p = m.inverse() * Vec3::new(a.offset, b.offset, c.offset);
-                if planes.iter().all(|pl| pl.distance(p) <= 1e-4 * (1.0 + p.length())) {
-                    out.push(p);
-                }
-            }
-        }
-    }
-    out
 }
 
 /// Whether the convex polyhedron `planes` has volume (its vertices do not all lie in
