@@ -89,7 +89,7 @@ struct GpuRun {
 impl GpuRun {
     fn new(w: u32, h: u32, datasets: &[LoadedDataset]) -> Result<Self, String> {
         let mut off = Offscreen::new(w, h, |app| {
-            app.add_plugins(FocalPlugins);
+            app.add_plugins((FocalPlugins, crate::windows::frames::WindowFramePlugin));
         })?;
         let entities = datasets.iter().map(|d| off.world_mut().spawn((dataset_component(d), transform(d))).id()).collect();
         Ok(GpuRun { off, entities })

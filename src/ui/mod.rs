@@ -422,7 +422,7 @@ pub fn run(initial: Option<PathBuf>, screenshot_and_exit: Option<(u32, PathBuf)>
             primary_window: Some(Window { title: "Focal".into(), resolution: window.into(), ..default() }),
             ..default()
         }))
-        .add_plugins(crate::FocalPlugins)
+        .add_plugins((crate::FocalPlugins, crate::windows::frames::WindowFramePlugin))
         .add_plugins(FocalAppPlugin { initial, screenshot_and_exit })
         .run()
 }

@@ -17,6 +17,7 @@
 
 pub mod boxes;
 pub mod components;
+pub mod frames;
 pub mod mapping;
 pub mod regions;
 pub mod spec;
