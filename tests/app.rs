@@ -145,3 +145,35 @@ fn scenes_bring_their_lenses_and_data_files_keep_them() {
     app.update();
     assert!(lenses(app.world_mut()).is_empty());
 }
+
+#[test]
+fn scenes_bring_their_windows() {
+    use focal::windows::{Attachment, Source, VolumeWindow};
+    let dir = scratch("app-windows");
+    let scene = dir.join("windows.ron");
+    std::fs::write(
+        &scene,
+        "(datasets: [(source: Phantom(kind: sphere, resolution: 16)), (source: Phantom(kind: head, resolution: 16))],
+          windows: [
+            (center: (0.0, 0.0, 0.0), size: (8.0, 8.0, 8.0), clip: true, contents: [(dataset: 1, appearance: Some((mode: mip)))]),
+            (center: (50.0, 0.0, 0.0), size: (8.0, 8.0, 8.0), source: Box(center: (0.0, 0.0, 0.0), size: (4.0, 4.0, 4.0)), attachment: Dataset(0), contents: [(dataset: 0)]),
+          ])",
+    )
+    .unwrap();
+    let mut app = headless_app();
+    app.world_mut().write_message(LoadRequest::Path(scene));
+    let windows = |w: &mut World| w.query::<&VolumeWindow>().iter(w).cloned().collect::<Vec<_>>();
+    run_until(&mut app, |w| windows(w).len() == 2);
+    let mut loaded = windows(app.world_mut());
+    loaded.sort_by_key(|w| w.clip);
+    let head =
+        app.world_mut().query::<(Entity, &Dataset)>().iter(app.world()).find(|(_, d)| d.volume.name.contains("head")).map(|(e, _)| e);
+    let (magnifier, clip) = (&loaded[0], &loaded[1]);
+    assert!(clip.clip && clip.contents[0].dataset == head.unwrap());
+    assert_eq!(clip.contents[0].appearance.as_ref().map(|a| a.mode), Some(focal::region::Mode::Mip));
+    assert!(matches!(magnifier.source, Source::Box(_)) && matches!(magnifier.attachment, Attachment::Dataset { .. }));
+    // The regions: two datasets (one cut into pieces by the clip window) and two windows.
+    app.update();
+    let n = app.world().resource::<focal::dataset::SceneRegions>().scene.regions.len();
+    assert!(n > 4, "{n} regions");
+}

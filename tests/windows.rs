@@ -232,7 +232,7 @@ fn scene_windows_give_the_same_regions_in_the_app_and_the_reference() {
         datasets.iter().map(|d| app.world_mut().spawn((d.component(), Transform::from_matrix(Mat4::from(d.transform)))).id()).collect();
     let viewer = app.world_mut().spawn(camera_bundle(&cam).0).id();
     let looks = window_appearances(&scene, &datasets, base).unwrap();
-    replace_windows(app.world_mut(), &scene.windows, &looks, &entities, viewer, scene.pointer.map(|(x, y, z)| Vec3::new(x, y, z)));
+    replace_windows(app.world_mut(), &scene.windows, &looks, &entities, Some(viewer), scene.pointer.map(|(x, y, z)| Vec3::new(x, y, z)));
     app.update();
     let ecs = app.world().resource::<SceneRegions>().scene.clone();
     // The clip window cuts the head into pieces, then the five windows' regions.

@@ -110,7 +110,7 @@ impl GpuRun {
         let looks = window_appearances(scene, datasets, base)?;
         let camera = self.off.camera();
         let pointer = scene.pointer.map(|(x, y, z)| Vec3::new(x, y, z));
-        replace_windows(self.off.world_mut(), &scene.windows, &looks, &self.entities, camera, pointer);
+        replace_windows(self.off.world_mut(), &scene.windows, &looks, &self.entities, Some(camera), pointer);
         let r = scene.rendering;
         self.off.set_view(VolumeView {
             jitter: r.jitter,

@@ -132,19 +132,37 @@ pub fn finish_loads(
                         commands.spawn((lens.clone(), LensOrder(i as u32), Name::new(format!("lens {}", lens.kind_name()))));
                     }
                 }
-                for d in &datasets {
-                    commands.spawn((
-                        d.component(),
-                        Transform::from_matrix(Mat4::from(d.transform)),
-                        DatasetOrigin(d.spec.clone()),
-                        Name::new(d.name.clone()),
-                    ));
+                let entities: Vec<Entity> = datasets
+                    .iter()
+                    .map(|d| {
+                        commands
+                            .spawn((
+                                d.component(),
+                                Transform::from_matrix(Mat4::from(d.transform)),
+                                DatasetOrigin(d.spec.clone()),
+                                Name::new(d.name.clone()),
+                            ))
+                            .id()
+                    })
+                    .collect();
+                let mut window_error = None;
+                if is_scene {
+                    // A scene's windows replace the current ones.
+                    match crate::scene::load::window_appearances(&scene, &datasets, &base) {
+                        Ok(looks) => {
+                            let (windows, pointer) = (scene.windows.clone(), scene.pointer.map(|(x, y, z)| Vec3::new(x, y, z)));
+                            commands.queue(move |world: &mut World| {
+                                crate::windows::spec::replace_windows(world, &windows, &looks, &entities, None, pointer);
+                            });
+                        }
+                        Err(e) => window_error = Some(format!("{}: {e}", load.what)),
+                    }
                 }
                 light.0 = scene.light;
                 session.reframe = Some(Reframe { bounds: visible_bounds(&datasets), camera: is_scene.then(|| scene.camera.clone()) });
                 session.scene = Some(scene);
                 session.base = base;
-                session.error = None;
+                session.error = window_error;
             }
             Err(e) => {
                 error!("{}: {e}", load.what);

@@ -13,6 +13,7 @@ pub mod objects_panel;
 pub mod orbit;
 pub mod panels;
 pub mod tf_editor;
+pub mod windows_panel;
 
 use crate::context::ContextParams;
 use std::path::PathBuf;
@@ -177,6 +178,7 @@ fn setup(commands: &mut Commands, egui: &mut EguiGlobalSettings) {
         projection,
         orbit,
         VolumeView::default(),
+        crate::windows::Viewer,
     ));
     commands.spawn((
         PrimaryEguiContext,

@@ -32,6 +32,7 @@ pub fn ui(
     mut load: MessageWriter<LoadRequest>,
     mut lens_params: lenses::LensParams,
     clip_gizmo: Res<super::clip_gizmo::ClipGizmo>,
+    mut window_params: super::windows_panel::WindowParams,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(
@@ -139,6 +140,21 @@ pub fn ui(
                 });
             }
             egui::CollapsingHeader::new("Lenses").default_open(true).show(ui, |ui| lenses::panel(ui, &mut lens_params));
+            egui::CollapsingHeader::new("Volumetric windows").default_open(false).show(ui, |ui| {
+                let rows: Vec<super::windows_panel::DatasetRow> = ds
+                    .iter()
+                    .map(|(e, d, _, _, t)| super::windows_panel::DatasetRow {
+                        entity: *e,
+                        name: d.volume.name.clone(),
+                        appearance: d.appearance.clone(),
+                        transform: **t,
+                    })
+                    .collect();
+                let (lo, hi) = scene_bounds(&regions);
+                if let Ok((orbit, _)) = cams.single() {
+                    super::windows_panel::panel(ui, &mut window_params, &rows, selected, orbit, (hi - lo).length());
+                }
+            });
             egui::CollapsingHeader::new("Camera").default_open(true).show(ui, |ui| {
                 if let Ok((mut orbit, _)) = cams.single_mut() {
                     camera_panel(ui, &mut orbit, scene_bounds(&regions));

@@ -206,13 +206,14 @@ pub fn placed(spec: &WindowSpec, boxes: (OrientedBox, OrientedBox), contents: Ve
 
 /// Replaces the windows, source boxes and pointer of `world` by those of a scene:
 /// `datasets` are the dataset entities, `appearances` each content's appearance (in
-/// order, `None`: the dataset's), `camera` the viewer.
+/// order, `None`: the dataset's), `camera` the viewer (marked [`Viewer`]; `None`: the
+/// viewer stays as it is).
 pub fn replace_windows(
     world: &mut World,
     windows: &[WindowSpec],
     appearances: &[Vec<Option<Appearance>>],
     datasets: &[Entity],
-    camera: Entity,
+    camera: Option<Entity>,
     pointer: Option<Vec3>,
 ) {
     let old: Vec<Entity> =
@@ -220,7 +221,9 @@ pub fn replace_windows(
     for e in old {
         world.despawn(e);
     }
-    world.entity_mut(camera).insert(Viewer);
+    if let Some(camera) = camera {
+        world.entity_mut(camera).insert(Viewer);
+    }
     if let Some(p) = pointer {
         world.spawn((Pointer3d, Transform::from_translation(p)));
     }

@@ -1,0 +1,142 @@
+//! The Volumetric windows panel: add a lens window, a clip box, a magnifier (a source
+//! box with its window beside it) or a world-in-miniature fixed to the view; per
+//! window: clip, fit, orientation coupling, attachment (room, user, dataset), size,
+//! which datasets it shows, remove.
+
+use bevy::ecs::system::SystemParam;
+use bevy::prelude::*;
+use bevy_egui::egui::{self, Ui};
+
+use super::MainCamera;
+use super::orbit::OrbitCamera;
+use crate::dataset::Dataset;
+use crate::region::Appearance;
+use crate::windows::{Attachment, Automation, Content, Fit, Orientation, Source, SourceBox, VolumeWindow};
+
+/// The window entities and the commands to add and remove them.
+#[derive(SystemParam)]
+pub struct WindowParams<'w, 's> {
+    #[allow(clippy::type_complexity)]
+    pub windows: Query<'w, 's, (Entity, &'static mut VolumeWindow, &'static GlobalTransform), (Without<Dataset>, Without<MainCamera>)>,
+    pub commands: Commands<'w, 's>,
+}
+
+/// A loaded dataset as the panel needs it.
+pub struct DatasetRow {
+    pub entity: Entity,
+    pub name: String,
+    pub appearance: Appearance,
+    pub transform: Transform,
+}
+
+/// The panel. `selected` is the dataset new windows show; `extent` the scene's size.
+pub fn panel(ui: &mut Ui, p: &mut WindowParams, datasets: &[DatasetRow], selected: usize, orbit: &OrbitCamera, extent: f32) {
+    let content =
+        datasets.get(selected).map(|d| vec![Content { dataset: d.entity, appearance: Some(d.appearance.clone()) }]).unwrap_or_default();
+    let cam = orbit.camera();
+    let at = orbit.target;
+    ui.horizontal_wrapped(|ui| {
+        if ui.button("lens").on_hover_text("a window showing the data in place, with its own look").clicked() {
+            p.commands.spawn((VolumeWindow::new(Vec3::splat(extent / 3.0), content.clone()), Transform::from_translation(at)));
+        }
+        if ui.button("clip box").on_hover_text("cuts the view away inside itself").clicked() {
+            p.commands.spawn((
+                VolumeWindow { clip: true, ..VolumeWindow::new(Vec3::splat(extent / 3.0), vec![]) },
+                Transform::from_translation(at),
+            ));
+        }
+        if ui.button("magnifier").on_hover_text("a source box at the centre, its window (×2) beside the data").clicked() {
+            let source = p.commands.spawn((SourceBox { size: Vec3::splat(extent / 8.0) }, Transform::from_translation(at))).id();
+            let w = VolumeWindow { source: Source::Box(source), ..VolumeWindow::new(Vec3::splat(extent / 4.0), content.clone()) };
+            p.commands.spawn((w, Transform::from_translation(at + cam.right() * extent * 0.7)));
+        }
+        if ui.button("world-in-miniature").on_hover_text("the whole data, small, fixed in the view's corner").clicked() {
+            let d = orbit.distance;
+            let offset = Transform::from_xyz(0.12 * d, 0.09 * d, -0.45 * d);
+            let all = datasets.iter().map(|d| Content { dataset: d.entity, appearance: None }).collect();
+            let w = VolumeWindow {
+                attachment: Attachment::User { offset },
+                automation: Automation { fit: Some(Fit::Uniform), orientation: Orientation::MainView },
+                ..VolumeWindow::new(Vec3::splat(0.08 * d), all)
+            };
+            p.commands.spawn((w, Transform::default()));
+        }
+    });
+    let viewer = orbit.bevy().0;
+    let mut remove = None;
+    let mut list: Vec<_> = p.windows.iter_mut().collect();
+    list.sort_by_key(|(e, ..)| *e);
+    for (k, (entity, w, global)) in list.iter_mut().enumerate() {
+        ui.separator();
+        ui.horizontal(|ui| {
+            ui.label(format!("window {}", k + 1));
+            ui.checkbox(&mut w.clip, "clip");
+            let mut fit = w.automation.fit.is_some();
+            if ui.checkbox(&mut fit, "fit").changed() {
+                w.automation.fit = fit.then_some(Fit::Uniform);
+            }
+            let mut coupled = w.automation.orientation == Orientation::MainView;
+            if ui.checkbox(&mut coupled, "keep view orientation").changed() {
+                w.automation.orientation = if coupled { Orientation::MainView } else { Orientation::Free };
+            }
+            if ui.small_button("✖").clicked() {
+                remove = Some((*entity, w.source));
+            }
+        });
+        // Attachment: the window stays where it is, its offset taken in the new frame.
+        let here = global.compute_transform();
+        let current = match w.attachment {
+            Attachment::Room => 0,
+            Attachment::User { .. } => 1,
+            Attachment::Dataset { .. } => 2,
+        };
+        let mut chosen = current;
+        ui.horizontal(|ui| {
+            ui.label("fixed to");
+            ui.radio_value(&mut chosen, 0, "room");
+            ui.radio_value(&mut chosen, 1, "view");
+            ui.radio_value(&mut chosen, 2, "data");
+        });
+        if chosen != current {
+            let first = w.contents.first().map(|c| c.dataset).or(datasets.first().map(|d| d.entity));
+            let frame_of = |e: Entity| datasets.iter().find(|d| d.entity == e).map(|d| d.transform);
+            w.attachment = match (chosen, first.and_then(|e| frame_of(e).map(|t| (e, t)))) {
+                (1, _) => Attachment::User { offset: relative(viewer, here) },
+                (2, Some((dataset, t))) => Attachment::Dataset { dataset, offset: relative(t, here) },
+                _ => Attachment::Room,
+            };
+            if chosen == 0 {
+                p.commands.entity(*entity).insert(here);
+            }
+        }
+        let mut scale = w.size.max_element();
+        if ui.add(egui::Slider::new(&mut scale, 1.0..=extent.max(2.0)).logarithmic(true).text("size (mm)")).changed() {
+            let old = w.size.max_element().max(1e-3);
+            w.size *= scale / old;
+        }
+        ui.horizontal_wrapped(|ui| {
+            ui.label("shows");
+            for d in datasets {
+                let mut on = w.contents.iter().any(|c| c.dataset == d.entity);
+                if ui.checkbox(&mut on, &d.name).changed() {
+                    if on {
+                        w.contents.push(Content { dataset: d.entity, appearance: None });
+                    } else {
+                        w.contents.retain(|c| c.dataset != d.entity);
+                    }
+                }
+            }
+        });
+    }
+    if let Some((e, source)) = remove {
+        p.commands.entity(e).despawn();
+        if let Source::Box(b) = source {
+            p.commands.entity(b).despawn();
+        }
+    }
+}
+
+/// `child`'s pose in the frame of `parent`.
+fn relative(parent: Transform, child: Transform) -> Transform {
+    Transform::from_matrix(Mat4::from(parent.compute_affine().inverse() * child.compute_affine()))
+}
