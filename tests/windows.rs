@@ -264,3 +264,72 @@ fn window_specs_with_bad_indices_are_reported() {
     // A typo in a field is a parse error naming it.
     assert!(SceneFile::parse(&SCENE.replace("clip: true", "clips: true"), "t").unwrap_err().contains("clips"));
 }
+
+#[test]
+fn window_entities_are_saved_as_the_specs_they_came_from() {
+    use focal::scene::file::SceneFile;
+    use focal::scene::load::{load_datasets, window_appearances};
+    use focal::windows::spec::{OrientationSpec, SourceSpec, replace_windows, window_spec};
+    let base = std::path::Path::new(".");
+    let scene = SceneFile::parse(SCENE, "t").unwrap();
+    let datasets = load_datasets(&scene, base).unwrap();
+    let mut app = app();
+    let entities: Vec<Entity> =
+        datasets.iter().map(|d| app.world_mut().spawn((d.component(), Transform::from_matrix(Mat4::from(d.transform)))).id()).collect();
+    let viewer = app.world_mut().spawn((Transform::from_xyz(0.0, -400.0, 0.0),)).id();
+    let looks = window_appearances(&scene, &datasets, base).unwrap();
+    replace_windows(app.world_mut(), &scene.windows, &looks, &entities, Some(viewer), None);
+    app.update();
+    let world = app.world_mut();
+    let mut windows: Vec<(Entity, VolumeWindow, Transform)> = world
+        .query::<(Entity, &VolumeWindow, &GlobalTransform)>()
+        .iter(world)
+        .map(|(e, w, g)| (e, w.clone(), g.compute_transform()))
+        .collect();
+    windows.sort_by_key(|(e, ..)| *e);
+    let order: Vec<Entity> = windows.iter().map(|(e, ..)| *e).collect();
+    let sources: Vec<(Entity, Transform, Vec3)> =
+        world.query::<(Entity, &SourceBox, &GlobalTransform)>().iter(world).map(|(e, s, g)| (e, g.compute_transform(), s.size)).collect();
+    let saved: Vec<_> = windows
+        .iter()
+        .map(|(_, w, pose)| {
+            window_spec(
+                w,
+                *pose,
+                |e| entities.iter().position(|d| *d == e),
+                |b| sources.iter().find(|(e, ..)| *e == b).map(|(_, t, s)| (*t, *s)),
+                &order,
+            )
+        })
+        .collect();
+    assert_eq!(saved.len(), scene.windows.len());
+    let tuple_close = |a: (f32, f32, f32), b: (f32, f32, f32)| (Vec3::from(a) - Vec3::from(b)).length() < 1e-3;
+    // Saved in entity order, which need not be the file's: pair them by pose and size.
+    let original = |s: &focal::windows::spec::WindowSpec| {
+        scene
+            .windows
+            .iter()
+            .find(|o| tuple_close(s.center, o.center) && tuple_close(s.size, o.size))
+            .unwrap_or_else(|| panic!("{s:?} is in no original"))
+    };
+    for s in &saved {
+        let o = original(s);
+        assert!(tuple_close(s.rotation_deg, o.rotation_deg), "{s:?} vs {o:?}");
+        assert_eq!((s.attachment, s.clip, s.fit), (o.attachment, o.clip, o.fit));
+        match (s.orientation, o.orientation) {
+            // Coupled to the same window, whatever its index.
+            (OrientationSpec::Window(a), OrientationSpec::Window(b)) => assert!(tuple_close(saved[a].center, scene.windows[b].center)),
+            (a, b) => assert_eq!(a, b),
+        }
+        assert_eq!(s.contents.iter().map(|c| c.dataset).collect::<Vec<_>>(), o.contents.iter().map(|c| c.dataset).collect::<Vec<_>>());
+        let modes =
+            |w: &focal::windows::spec::WindowSpec| w.contents.iter().map(|c| c.appearance.as_ref().map(|a| a.mode)).collect::<Vec<_>>();
+        assert_eq!(modes(s), modes(o));
+        match (s.source, o.source) {
+            (SourceSpec::Box { center: a, size: b, rotation_deg: c }, SourceSpec::Box { center: x, size: y, rotation_deg: z }) => {
+                assert!(tuple_close(a, x) && tuple_close(b, y) && tuple_close(c, z))
+            }
+            (a, b) => assert_eq!(a, b),
+        }
+    }
+}

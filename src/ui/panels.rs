@@ -219,6 +219,10 @@ pub fn ui(
                 load.write(LoadRequest::Path(path));
             }
             DialogPurpose::SaveScene => {
+                // The saved datasets, in the order ds_states writes them.
+                let mut saved: Vec<Entity> = datasets.iter().filter(|(_, _, _, o, _)| o.is_some()).map(|(e, ..)| e).collect();
+                saved.sort();
+                let windows = window_params.specs(&saved);
                 let result = save_scene(
                     &path,
                     &ds_states(&datasets),
@@ -227,6 +231,7 @@ pub fn ui(
                     light.0,
                     &session,
                     &lens_params.ordered().into_iter().map(|(_, l, _)| l).collect::<Vec<_>>(),
+                    windows,
                 );
                 if let Err(e) = result {
                     session.error = Some(e);
@@ -433,6 +438,7 @@ fn ds_states<'a>(
     rows.into_iter().map(|(_, r)| r).collect()
 }
 
+#[allow(clippy::too_many_arguments)]
 fn save_scene(
     path: &std::path::Path,
     rows: &[DatasetRow],
@@ -441,6 +447,7 @@ fn save_scene(
     light: Light,
     session: &Session,
     lenses: &[crate::lens::Lens],
+    windows: Vec<crate::windows::spec::WindowSpec>,
 ) -> Result<(), String> {
     use crate::scene::save::{DatasetState, scene_file};
     let states: Vec<DatasetState> = rows
@@ -456,7 +463,8 @@ fn save_scene(
         .collect();
     let camera = camera.ok_or("no camera")?;
     let size = session.scene.as_ref().map(|s| s.size).unwrap_or((512, 512));
-    let scene = scene_file(&states, &camera, background, light, size, lenses, &session.base);
+    let mut scene = scene_file(&states, &camera, background, light, size, lenses, &session.base);
+    scene.windows = windows;
     let path = if path.extension().is_some_and(|e| e == "ron") { path.to_path_buf() } else { path.with_extension("ron") };
     std::fs::write(&path, scene.to_ron()?).map_err(|e| format!("{}: {e}", path.display()))
 }

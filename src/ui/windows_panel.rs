@@ -18,7 +18,28 @@ use crate::windows::{Attachment, Automation, Content, Fit, Orientation, Source, 
 pub struct WindowParams<'w, 's> {
     #[allow(clippy::type_complexity)]
     pub windows: Query<'w, 's, (Entity, &'static mut VolumeWindow, &'static GlobalTransform), (Without<Dataset>, Without<MainCamera>)>,
+    pub sources: Query<'w, 's, (&'static SourceBox, &'static GlobalTransform)>,
     pub commands: Commands<'w, 's>,
+}
+
+impl WindowParams<'_, '_> {
+    /// The windows as scene-file specs; `datasets` are the saved datasets' entities in order.
+    pub fn specs(&self, datasets: &[Entity]) -> Vec<crate::windows::spec::WindowSpec> {
+        let mut list: Vec<_> = self.windows.iter().collect();
+        list.sort_by_key(|(e, ..)| *e);
+        let order: Vec<Entity> = list.iter().map(|(e, ..)| *e).collect();
+        list.iter()
+            .map(|(_, w, g)| {
+                crate::windows::spec::window_spec(
+                    w,
+                    g.compute_transform(),
+                    |e| datasets.iter().position(|d| *d == e),
+                    |b| self.sources.get(b).ok().map(|(s, g)| (g.compute_transform(), s.size)),
+                    &order,
+                )
+            })
+            .collect()
+    }
 }
 
 /// A loaded dataset as the panel needs it.

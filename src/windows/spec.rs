@@ -258,3 +258,61 @@ pub fn replace_windows(
         world.entity_mut(*e).insert((window, w.pose()));
     }
 }
+
+/// A window entity as a spec (for saving): `pose` is the window's world pose,
+/// `dataset_index` the saved index of a dataset entity, `source` a source box entity's
+/// world pose and size, `windows` the saved order of the window entities.
+pub fn window_spec(
+    w: &VolumeWindow,
+    pose: Transform,
+    dataset_index: impl Fn(Entity) -> Option<usize>,
+    source: impl Fn(Entity) -> Option<(Transform, Vec3)>,
+    windows: &[Entity],
+) -> WindowSpec {
+    let tuple = |v: Vec3| (v.x, v.y, v.z);
+    let degrees = |q: Quat| {
+        let (x, y, z) = q.to_euler(EulerRot::XYZ);
+        (x.to_degrees(), y.to_degrees(), z.to_degrees())
+    };
+    let (attachment, local) = match w.attachment {
+        Attachment::Room => (AttachmentSpec::Room, pose),
+        Attachment::User { offset } => (AttachmentSpec::User, offset),
+        Attachment::Dataset { dataset, offset } => match dataset_index(dataset) {
+            Some(i) => (AttachmentSpec::Dataset(i), offset),
+            None => (AttachmentSpec::Room, pose),
+        },
+    };
+    let source = match w.source {
+        Source::Own => SourceSpec::Own,
+        Source::Box(b) => match source(b) {
+            Some((t, size)) => SourceSpec::Box { center: tuple(t.translation), size: tuple(size), rotation_deg: degrees(t.rotation) },
+            None => SourceSpec::Own,
+        },
+        Source::Pointer { size } => SourceSpec::Pointer { size: tuple(size) },
+    };
+    WindowSpec {
+        center: tuple(local.translation),
+        rotation_deg: degrees(local.rotation),
+        size: tuple(w.size),
+        contents: w
+            .contents
+            .iter()
+            .filter_map(|c| {
+                let dataset = dataset_index(c.dataset)?;
+                Some(ContentSpec { dataset, appearance: c.appearance.as_ref().map(|a| crate::scene::save::appearance_spec(a, None)) })
+            })
+            .collect(),
+        source,
+        attachment,
+        clip: w.clip,
+        fit: w.automation.fit.map(|f| match f {
+            Fit::Uniform => FitSpec::Uniform,
+            Fit::PerAxis => FitSpec::PerAxis,
+        }),
+        orientation: match w.automation.orientation {
+            Orientation::Free => OrientationSpec::Free,
+            Orientation::MainView => OrientationSpec::MainView,
+            Orientation::Window(e) => windows.iter().position(|x| *x == e).map_or(OrientationSpec::Free, OrientationSpec::Window),
+        },
+    }
+}
