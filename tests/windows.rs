@@ -333,3 +333,41 @@ fn window_entities_are_saved_as_the_specs_they_came_from() {
         }
     }
 }
+
+#[test]
+fn overlapping_clip_windows_cut_the_union_and_both_show() {
+    let mut app = app();
+    let data = head(&mut app);
+    let bone = Appearance::new(Mode::Dvr, presets::builtin("ct_bone").unwrap());
+    let mip = Appearance::new(Mode::Mip, presets::builtin("grayscale_ramp").unwrap());
+    for (x, look) in [(-15.0, bone), (15.0, mip)] {
+        let w =
+            VolumeWindow { clip: true, ..VolumeWindow::new(Vec3::splat(50.0), vec![Content { dataset: data, appearance: Some(look) }]) };
+        app.world_mut().spawn((w, Transform::from_xyz(x, 0.0, 0.0)));
+    }
+    app.update();
+    let scene = app.world().resource::<SceneRegions>().scene.clone();
+    let n = scene.regions.len();
+    let (pieces, windows) = scene.regions.split_at(n - 2);
+    let strictly = |r: &Region, p: Vec3| r.planes.iter().all(|pl| pl.distance(p) < -1e-3);
+    let in_box = |c: f32, p: Vec3| (p - Vec3::new(c, 0.0, 0.0)).abs().max_element() < 25.0 - 1e-2;
+    let mut both = 0;
+    for i in 0..15 {
+        for j in 0..15 {
+            for k in 0..15 {
+                let p = Vec3::new(i as f32, j as f32, k as f32) * 7.0 - 49.0 + 0.31;
+                let (a, b) = (in_box(-15.0, p), in_box(15.0, p));
+                let data_count = pieces.iter().filter(|r| strictly(r, p)).count();
+                // The datasets are cut by the union of the clip boxes…
+                assert_eq!(data_count, usize::from(!a && !b), "{p}: {data_count} dataset pieces");
+                // …and each window shows its own content in its whole box, overlap included.
+                assert_eq!(strictly(&windows[0], p) || strictly(&windows[1], p), a || b, "{p}");
+                if a && b {
+                    assert!(strictly(&windows[0], p) && strictly(&windows[1], p));
+                    both += 1;
+                }
+            }
+        }
+    }
+    assert!(both > 50, "the grid barely met the overlap: {both}");
+}
