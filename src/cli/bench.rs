@@ -20,6 +20,7 @@ use std::sync::Arc;
 use bevy::prelude::*;
 use clap::Args;
 use focal::FocalPlugins;
+use focal::clip::{ClipPlane, Clipping};
 use focal::context::{ContextParams, Power};
 use focal::dataset::Dataset;
 use focal::lens::systems::replace_lenses;
@@ -199,6 +200,10 @@ impl Bench {
     }
 }
 
+/// The second half of the head in the windows group's two-region configuration.
+#[derive(Component)]
+struct BenchHalf;
+
 /// Names of configurations.
 fn names(configs: &[Config]) -> Vec<&'static str> {
     configs.iter().map(|c| c.0).collect()
@@ -336,7 +341,8 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
     }
 
     if all || args.windows {
-        // Volumetric windows on the head CT: none, one clip window showing the dataset as
+        // Volumetric windows on the head CT (the head as two clipped halves, two regions
+        // and the same picture, measures the multi-region shader alone): none, one clip window showing the dataset as
         // it is (the same picture: the cost of the window's regions alone), one showing
         // bone (a cutaway: the rays also go deeper), four windows (the clip window and three ×2 windows of
         // source boxes inside the head). Goals: one clip window ≤ ×1.10 (≥ 90 % of the
@@ -344,15 +350,28 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let ct = Arc::new(Phantom::Head.generate(args.resolution)?);
         let skin = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone")?);
         let bone = Appearance::new(Mode::Dvr, presets::builtin("ct_bone")?);
-        let names = ["no window", "one clip window, same look", "one clip window, bone", "four windows"];
+        let names = ["no window", "one clip window, same look", "one clip window, bone", "four windows", "no window, two halves"];
         let same = skin.clone();
-        let (ms, images) = bench.interleaved_by(ct, skin, 4, false, |off, i| {
+        let half = |flip: bool| Clipping { planes: vec![ClipPlane { flip, ..ClipPlane::new(Vec3::ZERO, Vec3::X) }], clip_box: None };
+        let (ms, images) = bench.interleaved_by(ct.clone(), skin.clone(), 5, false, |off, i| {
             let world = off.world_mut();
-            let old: Vec<Entity> = world.query_filtered::<Entity, Or<(With<VolumeWindow>, With<SourceBox>)>>().iter(world).collect();
+            let old: Vec<Entity> =
+                world.query_filtered::<Entity, Or<(With<VolumeWindow>, With<SourceBox>, With<BenchHalf>)>>().iter(world).collect();
             for e in old {
                 world.despawn(e);
             }
             let Some(data) = world.query_filtered::<Entity, With<Dataset>>().iter(world).next() else { return };
+            // The last configuration: the head as two datasets, each clipped to one half
+            // (the same picture from two regions: the multi-region shader alone).
+            if let Some(mut d) = world.get_mut::<Dataset>(data) {
+                d.clip = if i == 4 { half(false) } else { Clipping::default() };
+            }
+            if i == 4 {
+                let mut other = Dataset::new(ct.clone(), skin.clone());
+                other.clip = half(true);
+                world.spawn((other, Transform::default(), BenchHalf));
+                return;
+            }
             let look = if i == 1 { same.clone() } else { bone.clone() };
             let content = vec![Content { dataset: data, appearance: Some(look) }];
             if i >= 1 {
@@ -369,8 +388,9 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             }
         })?;
         let note = format!(
-            "same look differs from no window by at most {} levels; goals: one clip window ≤ ×1.10, four ≤ ×1.33",
-            difference(&images[0], &images[1])
+            "same look and two halves differ from no window by at most {} and {} levels; goals: one clip window ≤ ×1.10, four ≤ ×1.33",
+            difference(&images[0], &images[1]),
+            difference(&images[0], &images[4])
         );
         push_group(&mut rows, "windows", &names, &ms, "head phantom", &note);
     }
