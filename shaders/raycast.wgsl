@@ -176,6 +176,26 @@ fn past_brick(r: Region, g: Segment, q: vec3<f32>, kk: f32) -> f32 {
     return max(kk + 1.0, ceil((brick_exit(r, q, g.qd, segment_t(g, kk)) - g.t_start) / g.step - g.j));
 }
 
+// The first sample from kk on (at most k_end + 1) that lies in an occupied brick or
+// below full resolution: empty bricks are crossed in a loop of their own, so the lanes
+// of a SIMD group that skip wait for each other there, then all take the next
+// (expensive) sample together. Occupancy holds for full-resolution samples only (a
+// coarser level blends in neighbouring bricks).
+fn past_empty_bricks(r: Region, g: Segment, kk_in: f32, k_end: f32) -> f32 {
+    var kk = kk_in;
+    for (var skip_steps = 0u; skip_steps < scene.max_steps; skip_steps++) {
+        if kk > k_end {
+            break;
+        }
+        let q = segment_point(g, kk);
+        if !at_full_resolution() || brick_occupied(r, q) {
+            break;
+        }
+        kk = past_brick(r, g, q, kk);
+    }
+    return kk;
+}
+
 fn projected(mode: u32, vmax: f32, vmin: f32, vsum: f32, count: u32) -> f32 {
     if mode == MODE_MIP {
         return vmax;
@@ -460,16 +480,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                     // are crossed as DVR crosses empty bricks; the open segment ends there.
                     if occupancy {
                         let before_skip = kk;
-                        for (var skip_steps = 0u; skip_steps < scene.max_steps; skip_steps++) {
-                            if kk > k_end {
-                                break;
-                            }
-                            let q = segment_point(g, kk);
-                            if !at_full_resolution() || brick_occupied(r, q) {
-                                break;
-                            }
-                            kk = past_brick(r, g, q, kk);
-                        }
+                        kk = past_empty_bricks(r, g, kk, k_end);
                         if kk > before_skip {
                             acc = end_segment(r, part, &o, acc);
                         }
@@ -552,22 +563,8 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                     if kk > k_end || acc.a >= stop {
                         break;
                     }
-                    // Empty bricks are crossed in a loop of their own: the lanes of a
-                    // SIMD group that skip wait for each other there, then all lanes
-                    // take the next (expensive) sample together. Occupancy holds for
-                    // full-resolution samples only (a coarser level blends in
-                    // neighbouring bricks).
                     if occupancy {
-                        for (var skip_steps = 0u; skip_steps < scene.max_steps; skip_steps++) {
-                            if kk > k_end {
-                                break;
-                            }
-                            let q = segment_point(g, kk);
-                            if !at_full_resolution() || brick_occupied(r, q) {
-                                break;
-                            }
-                            kk = past_brick(r, g, q, kk);
-                        }
+                        kk = past_empty_bricks(r, g, kk, k_end);
                         if kk > k_end {
                             break;
                         }
