@@ -371,3 +371,108 @@ fn overlapping_clip_windows_cut_the_union_and_both_show() {
     }
     assert!(both > 50, "the grid barely met the overlap: {both}");
 }
+
+/// A ×2 magnifier at x = 200 (source: a 40 mm box at the head's centre) and a clip
+/// window of its own source at (0, 0, 60), both showing `data`.
+fn magnifier_and_clip(app: &mut App, data: Entity) -> (Entity, Entity) {
+    let source = app.world_mut().spawn((SourceBox { size: Vec3::splat(40.0) }, Transform::default())).id();
+    let content = vec![Content { dataset: data, appearance: None }];
+    let magnifier = VolumeWindow { source: Source::Box(source), ..VolumeWindow::new(Vec3::splat(80.0), content.clone()) };
+    let magnifier = app.world_mut().spawn((magnifier, Transform::from_xyz(200.0, 0.0, 0.0))).id();
+    let clip = VolumeWindow { clip: true, ..VolumeWindow::new(Vec3::splat(30.0), content) };
+    let clip = app.world_mut().spawn((clip, Transform::from_xyz(0.0, 0.0, 60.0))).id();
+    (magnifier, clip)
+}
+
+#[test]
+fn focus_follows_the_cursor_and_the_pointer_reaching_in() {
+    use focal::region::Ray;
+    use focal::windows::systems::{CursorRay, WindowFocus};
+    let mut app = app();
+    let data = head(&mut app);
+    let (magnifier, clip) = magnifier_and_clip(&mut app, data);
+    let pointer = app.world_mut().spawn((Pointer3d, Transform::from_xyz(0.0, 0.0, -500.0))).id();
+    let focus = |app: &mut App, cursor: Option<Ray>| {
+        app.world_mut().resource_mut::<CursorRay>().0 = cursor;
+        app.update();
+        app.world().resource::<WindowFocus>().0
+    };
+    let looking_down = |x: f32, z: f32| Some(Ray { origin: Vec3::new(x, -1000.0, z), dir: Vec3::Y });
+    // Hovering each window, then empty space (the head alone: the main view).
+    assert_eq!(focus(&mut app, looking_down(200.0, 0.0)), Some(magnifier));
+    assert_eq!(focus(&mut app, looking_down(0.0, 60.0)), Some(clip));
+    assert_eq!(focus(&mut app, looking_down(0.0, 0.0)), None);
+    // Over the panels (no cursor ray) the focus stays where it was.
+    assert_eq!(focus(&mut app, looking_down(200.0, 0.0)), Some(magnifier));
+    assert_eq!(focus(&mut app, None), Some(magnifier));
+    // The pointer reaching into the clip window takes the focus there, whatever the
+    // cursor hovers.
+    app.world_mut().get_mut::<Transform>(pointer).unwrap().translation = Vec3::new(5.0, 0.0, 62.0);
+    assert_eq!(focus(&mut app, looking_down(200.0, 0.0)), Some(clip));
+    // A removed window loses the focus.
+    app.world_mut().despawn(clip);
+    assert_eq!(focus(&mut app, None), None);
+}
+
+#[test]
+fn markers_show_in_every_view_of_their_point() {
+    use focal::windows::markers::{Marker, MarkerViews};
+    use focal::windows::systems::{delete_marker, move_marker, place_marker};
+    let mut app = app();
+    let data = head(&mut app);
+    let (magnifier, _clip) = magnifier_and_clip(&mut app, data);
+    let pointer = app.world_mut().spawn((Pointer3d, Transform::from_xyz(5.0, 0.0, 0.0))).id();
+    app.update();
+    let views = |app: &App, e: Entity| app.world().get::<MarkerViews>(e).map(|v| v.0.clone()).unwrap_or_default();
+    let same = |a: &[Vec3], b: &[Vec3]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| close(*x, *y));
+    // In the main view at (5, 0, 0): the marker is on the head there, and shows in the
+    // magnifier at 200 + 2·(5, 0, 0).
+    let m = place_marker(app.world_mut()).expect("the pointer is in the head");
+    app.update();
+    assert_eq!(app.world().get::<Marker>(m).unwrap().dataset, data);
+    assert!(same(&views(&app, m), &[Vec3::new(5.0, 0.0, 0.0), Vec3::new(210.0, 0.0, 0.0)]), "{:?}", views(&app, m));
+    // The pointer shows in the same views.
+    assert!(same(&views(&app, pointer), &[Vec3::new(5.0, 0.0, 0.0), Vec3::new(210.0, 0.0, 0.0)]));
+    // Reaching into the magnifier at (190, 10, 0) marks data point (−5, 5, 0): shown
+    // there in the main view and at the pointer in the magnifier.
+    app.world_mut().get_mut::<Transform>(pointer).unwrap().translation = Vec3::new(190.0, 10.0, 0.0);
+    app.update();
+    let reached = place_marker(app.world_mut()).unwrap();
+    app.update();
+    assert!(close(app.world().get::<Marker>(reached).unwrap().position, Vec3::new(-5.0, 5.0, 0.0)));
+    assert!(same(&views(&app, reached), &[Vec3::new(-5.0, 5.0, 0.0), Vec3::new(190.0, 10.0, 0.0)]));
+    // In the clip window's box (0, 0, 60): cut from the main view, shown in the clip
+    // window; outside the magnifier's source.
+    app.world_mut().get_mut::<Transform>(pointer).unwrap().translation = Vec3::new(0.0, 0.0, 60.0);
+    app.update();
+    let clipped = place_marker(app.world_mut()).unwrap();
+    app.update();
+    assert!(same(&views(&app, clipped), &[Vec3::new(0.0, 0.0, 60.0)]));
+    // The marker follows its dataset when the dataset moves; the magnifier's source box
+    // stays, so the first marker (now at (5, 0, 10)) shows at 200 + 2·(5, 0, 10).
+    *app.world_mut().get_mut::<Transform>(data).unwrap() = Transform::from_xyz(0.0, 0.0, 10.0);
+    app.update();
+    app.update();
+    assert!(same(&views(&app, m), &[Vec3::new(5.0, 0.0, 10.0), Vec3::new(210.0, 0.0, 20.0)]), "{:?}", views(&app, m));
+    // Moving the source box moves where the magnifier shows it.
+    let source = match app.world().get::<VolumeWindow>(magnifier).unwrap().source {
+        Source::Box(b) => b,
+        _ => unreachable!(),
+    };
+    app.world_mut().get_mut::<Transform>(source).unwrap().translation = Vec3::new(5.0, 0.0, 0.0);
+    app.update();
+    app.update();
+    assert!(same(&views(&app, m), &[Vec3::new(5.0, 0.0, 10.0), Vec3::new(200.0, 0.0, 20.0)]), "{:?}", views(&app, m));
+    // Moving a marker with the pointer: the pointer at the data point (5, 0, 12) in the
+    // main view (2 mm from the first marker).
+    app.world_mut().get_mut::<Transform>(pointer).unwrap().translation = Vec3::new(5.0, 0.0, 12.0);
+    app.update();
+    assert!(!move_marker(app.world_mut(), 1.0), "no marker within 1 mm");
+    assert!(move_marker(app.world_mut(), 3.0));
+    assert!(close(app.world().get::<Marker>(m).unwrap().position, Vec3::new(5.0, 0.0, 2.0)));
+    // Deleting: the nearest within the radius goes, the others stay.
+    assert!(delete_marker(app.world_mut(), 3.0));
+    assert!(app.world().get_entity(m).is_err());
+    assert!(app.world().get_entity(reached).is_ok() && app.world().get_entity(clipped).is_ok());
+    assert!(!delete_marker(app.world_mut(), 3.0));
+}

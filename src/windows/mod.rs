@@ -12,13 +12,17 @@
 //! (a world-in-miniature). A clip window cuts its box out of the datasets' regions,
 //! which splits each into convex pieces ([`boxes::subtract`]).
 //!
-//! [`boxes`], [`mapping`] and [`regions`] are pure; [`systems`] moves attached windows
-//! and places them every frame.
+//! [`boxes`], [`mapping`], [`regions`], [`interaction`] (focus, dragging, resizing) and
+//! [`markers`] (where markers and the 3D pointer show) are pure; [`systems`] moves
+//! attached windows, places them every frame, keeps the focus and the markers' views,
+//! and places, moves and deletes markers with the pointer.
 
 pub mod boxes;
 pub mod components;
 pub mod frames;
+pub mod interaction;
 pub mod mapping;
+pub mod markers;
 pub mod regions;
 pub mod spec;
 pub mod systems;
@@ -39,7 +43,11 @@ impl Plugin for VolumeWindowPlugin {
             (
                 systems::attach_windows.after(TransformSystems::Propagate).before(RegionSystems::Modify),
                 systems::window_regions.in_set(RegionSystems::Modify),
+                (systems::update_focus, systems::propagate_markers).after(RegionSystems::Modify),
             ),
-        );
+        )
+        .init_resource::<markers::PlacedWindows>()
+        .init_resource::<systems::CursorRay>()
+        .init_resource::<systems::WindowFocus>();
     }
 }

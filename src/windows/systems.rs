@@ -8,9 +8,12 @@ use bevy::prelude::*;
 
 use super::boxes::OrientedBox;
 use super::components::{Attachment, Orientation, Pointer3d, Source, SourceBox, Viewer, VolumeWindow};
+use super::interaction::focus;
 use super::mapping::{coupled_rotation, map_rotation};
+use super::markers::{Marker, MarkerViews, PlacedWindows, WindowView, data_point, views};
 use super::regions::{PlacedContent, PlacedWindow, add_windows};
 use crate::dataset::{Dataset, GpuVolume, SceneRegions};
+use crate::region::Ray;
 
 /// Keeps user- and dataset-attached windows at their offset from the viewer or the
 /// dataset (room windows stay where they are).
@@ -51,8 +54,12 @@ pub fn window_regions(
     pointers: Query<&GlobalTransform, With<Pointer3d>>,
     datasets: Query<(&Dataset, Option<&GpuVolume>, &GlobalTransform)>,
     mut out: ResMut<SceneRegions>,
+    mut views: ResMut<PlacedWindows>,
 ) {
     if windows.is_empty() {
+        if !views.0.is_empty() {
+            views.0.clear();
+        }
         return;
     }
     let mut list: Vec<_> = windows.iter().collect();
@@ -80,6 +87,7 @@ pub fn window_regions(
     let mut index = out.datasets.clone();
     let dataset_regions = scene.regions.len();
     let mut placed = Vec::new();
+    let mut placed_views = Vec::new();
     for (e, w, _) in &list {
         let Some(&(window, mut source)) = boxes.get(e) else { continue };
         let coupled = match w.automation.orientation {
@@ -106,11 +114,134 @@ pub fn window_regions(
                 Some(PlacedContent { volume, volume_index, dataset_to_world: g.affine(), appearance })
             })
             .collect();
-        placed.push(PlacedWindow { window, source, fit: w.automation.fit, clip: w.clip, contents });
+        let p = PlacedWindow { window, source, fit: w.automation.fit, clip: w.clip, contents };
+        let shown = w.contents.iter().map(|c| c.dataset).filter(|d| datasets.contains(*d)).collect();
+        placed_views.push((*e, WindowView { window, source: p.fitted_source(), clip: w.clip, datasets: shown }));
+        placed.push(p);
     }
+    views.0 = placed_views;
     add_windows(&mut scene, dataset_regions, &placed);
     if out.scene != scene {
         out.scene = scene;
     }
     out.datasets = index;
+}
+
+/// The cursor's ray in the world when it is over the view (set by the app every frame;
+/// `None` over the panels or outside the window).
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct CursorRay(pub Option<Ray>);
+
+/// The window with the focus (`None`: the main view). Panel settings apply to it.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WindowFocus(pub Option<Entity>);
+
+/// Gives the focus to the window the pointer reaches into or the cursor hovers
+/// ([`super::interaction::focus`]); a removed window loses it.
+pub fn update_focus(
+    placed: Res<PlacedWindows>,
+    cursor: Res<CursorRay>,
+    pointers: Query<&GlobalTransform, With<Pointer3d>>,
+    mut current: ResMut<WindowFocus>,
+) {
+    let boxes: Vec<(Entity, OrientedBox)> = placed.0.iter().map(|(e, v)| (*e, v.window)).collect();
+    let pointer = pointers.iter().next().map(|g| g.translation());
+    let mut next = focus(&boxes, cursor.0.as_ref(), pointer).unwrap_or(current.0);
+    if next.is_some_and(|e| placed.get(e).is_none()) {
+        next = None;
+    }
+    if current.0 != next {
+        current.0 = next;
+    }
+}
+
+/// Places every marker and the pointer in every view that shows their point
+/// ([`super::markers::views`]).
+#[allow(clippy::type_complexity)]
+pub fn propagate_markers(
+    mut commands: Commands,
+    placed: Res<PlacedWindows>,
+    datasets: Query<&GlobalTransform, With<Dataset>>,
+    mut markers: Query<(Entity, &Marker, Option<&mut MarkerViews>), Without<Pointer3d>>,
+    mut pointers: Query<(Entity, &GlobalTransform, Option<&mut MarkerViews>), (With<Pointer3d>, Without<Marker>)>,
+) {
+    let mut set = |e: Entity, shown: Vec<Vec3>, old: Option<Mut<MarkerViews>>| match old {
+        Some(mut v) if v.0 != shown => v.0 = shown,
+        Some(_) => {}
+        None => {
+            commands.entity(e).insert(MarkerViews(shown));
+        }
+    };
+    for (e, m, old) in &mut markers {
+        let shown =
+            datasets.get(m.dataset).map_or_else(|_| Vec::new(), |g| views(g.transform_point(m.position), Some(m.dataset), &placed.0));
+        set(e, shown, old);
+    }
+    for (e, g, old) in &mut pointers {
+        let (p, _) = data_point(g.translation(), &placed.0);
+        set(e, views(p, None, &placed.0), old);
+    }
+}
+
+/// The dataset whose box holds world point `p` among `candidates` (the first; else the
+/// first candidate when `fallback`).
+fn dataset_at(world: &mut World, p: Vec3, candidates: Option<&[Entity]>, fallback: bool) -> Option<(Entity, Vec3)> {
+    let mut q = world.query::<(Entity, &Dataset, &GlobalTransform)>();
+    let mut all: Vec<(Entity, Vec3, bool)> = q
+        .iter(world)
+        .filter(|(e, ..)| candidates.is_none_or(|c| c.contains(e)))
+        .map(|(e, d, g)| {
+            let local = g.affine().inverse().transform_point3(p);
+            let (lo, hi) = d.volume.grid.world_bounds();
+            (e, local, local.cmpge(lo.min(hi)).all() && local.cmple(lo.max(hi)).all())
+        })
+        .collect();
+    all.sort_by_key(|(e, ..)| *e);
+    all.iter().find(|(.., inside)| *inside).or(all.first().filter(|_| fallback)).map(|(e, local, _)| (*e, *local))
+}
+
+/// The data point under the pointer, its dataset and position in the dataset's frame:
+/// the dataset of the window the pointer reaches into, or the dataset holding it in
+/// the main view.
+fn pointed(world: &mut World) -> Option<(Vec3, Entity, Vec3)> {
+    let mut pointers = world.query_filtered::<&GlobalTransform, With<Pointer3d>>();
+    let pointer = pointers.iter(world).next()?.translation();
+    let placed = world.get_resource::<PlacedWindows>().cloned().unwrap_or_default();
+    let (p, window) = data_point(pointer, &placed.0);
+    let candidates = window.and_then(|w| placed.get(w)).map(|v| v.datasets.clone());
+    let (dataset, local) = dataset_at(world, p, candidates.as_deref(), candidates.is_some())?;
+    Some((p, dataset, local))
+}
+
+/// Places a marker at the data point under the 3D pointer (reaching into a window marks
+/// the data it shows); `None` when the pointer is in no dataset and no window.
+pub fn place_marker(world: &mut World) -> Option<Entity> {
+    let (_, dataset, position) = pointed(world)?;
+    Some(world.spawn(Marker { dataset, position }).id())
+}
+
+/// The marker nearest the data point under the pointer, within `radius` millimetres.
+fn marker_near(world: &mut World, radius: f32) -> Option<Entity> {
+    let (p, ..) = pointed(world)?;
+    let mut q = world.query::<(Entity, &Marker)>();
+    let found: Vec<(Entity, Entity, Vec3)> = q.iter(world).map(|(e, m)| (e, m.dataset, m.position)).collect();
+    found
+        .into_iter()
+        .filter_map(|(e, d, local)| world.get::<GlobalTransform>(d).map(|g| (e, g.transform_point(local).distance(p))))
+        .filter(|(_, d)| *d <= radius)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(e, _)| e)
+}
+
+/// Deletes the marker nearest the pointer's data point (within `radius`).
+pub fn delete_marker(world: &mut World, radius: f32) -> bool {
+    marker_near(world, radius).is_some_and(|e| world.despawn(e))
+}
+
+/// Moves the marker nearest the pointer's data point (within `radius`) onto it.
+pub fn move_marker(world: &mut World, radius: f32) -> bool {
+    let Some(e) = marker_near(world, radius) else { return false };
+    let Some((_, dataset, position)) = pointed(world) else { return false };
+    world.entity_mut(e).insert(Marker { dataset, position });
+    true
 }
