@@ -206,6 +206,7 @@ const SCENE: &str = r#"(
     ],
     camera: Orbit(azimuth_deg: 30.0, elevation_deg: 10.0),
     pointer: Some((10.0, 20.0, 0.0)),
+    markers: [(dataset: 0, position: (1.0, 2.0, 3.0)), (dataset: 1, position: (-4.0, 0.0, 8.0))],
     windows: [
         (center: (0.0, 0.0, 40.0), size: (60.0, 60.0, 60.0), clip: true, contents: [(dataset: 0, appearance: Some((mode: mip)))]),
         (center: (200.0, 0.0, 0.0), size: (50.0, 50.0, 50.0), source: Box(center: (0.0, 30.0, 0.0), size: (20.0, 20.0, 20.0), rotation_deg: (0.0, 0.0, 30.0)), contents: [(dataset: 1)]),
@@ -261,8 +262,32 @@ fn window_specs_with_bad_indices_are_reported() {
     assert!(bad("Dataset(0)", "Dataset(3)").contains("window 4: attached to dataset 3"));
     assert!(bad("Window(1)", "Window(2)").contains("window 2: orientation coupled to window 2"));
     assert!(bad("size: (12.0, 12.0, 12.0)", "size: (12.0, 0.0, 12.0)").contains("window 3: size"));
+    assert!(bad("(dataset: 1, position", "(dataset: 2, position").contains("marker 1: refers to dataset 2, the scene has 2"));
     // A typo in a field is a parse error naming it.
     assert!(SceneFile::parse(&SCENE.replace("clip: true", "clips: true"), "t").unwrap_err().contains("clips"));
+    assert!(SceneFile::parse(&SCENE.replace("position: (1.0", "postion: (1.0"), "t").unwrap_err().contains("postion"));
+}
+
+#[test]
+fn scene_markers_are_loaded_in_their_datasets_and_saved_back() {
+    use focal::scene::file::SceneFile;
+    use focal::windows::markers::Marker;
+    use focal::windows::spec::{marker_spec, replace_markers};
+    let scene = SceneFile::parse(SCENE, "t").unwrap();
+    scene.validate().unwrap();
+    let mut app = app();
+    let entities: Vec<Entity> = (0..2).map(|_| app.world_mut().spawn(Transform::default()).id()).collect();
+    // An old marker goes.
+    app.world_mut().spawn(Marker { dataset: entities[0], position: Vec3::ZERO });
+    replace_markers(app.world_mut(), &scene.markers, &entities);
+    let world = app.world_mut();
+    let mut markers: Vec<(Entity, Marker)> = world.query::<(Entity, &Marker)>().iter(world).map(|(e, m)| (e, *m)).collect();
+    // In the scene's order (the first marker lies at x = 1, the second at x = -4).
+    markers.sort_by(|(_, a), (_, b)| b.position.x.total_cmp(&a.position.x));
+    assert_eq!(markers.len(), 2);
+    assert_eq!(markers[1].1, Marker { dataset: entities[1], position: Vec3::new(-4.0, 0.0, 8.0) });
+    let saved: Vec<_> = markers.iter().filter_map(|(_, m)| marker_spec(m, |e| entities.iter().position(|d| *d == e))).collect();
+    assert_eq!(saved, scene.markers);
 }
 
 #[test]

@@ -167,6 +167,7 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
         lenses: Vec::new(),
         windows: Vec::new(),
         pointer: None,
+        markers: Vec::new(),
         frames: Vec::new(),
     })
 }

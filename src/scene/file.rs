@@ -74,6 +74,9 @@ pub struct SceneFile {
     /// The 3D pointer's position (world mm), for windows whose source follows it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pointer: Option<(f32, f32, f32)>,
+    /// Interpretive markers (shown in every view of their point).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub markers: Vec<crate::windows::spec::MarkerSpec>,
     /// Frames to capture; none means one frame of the scene as it is.
     #[serde(default)]
     pub frames: Vec<FrameSpec>,
@@ -423,6 +426,7 @@ impl SceneFile {
     pub fn validate(&self) -> Result<(), String> {
         validate_lenses(&self.lenses)?;
         self.validate_windows(&self.windows)?;
+        self.markers.iter().enumerate().try_for_each(|(i, m)| m.validate(i, self.datasets.len()))?;
         for frame in &self.frames {
             for change in &frame.set {
                 let checked = match change {

@@ -13,7 +13,7 @@ use crate::lens::systems::replace_lenses;
 use crate::reference::render_lensed;
 use crate::render::VolumeView;
 use crate::render::headless::Offscreen;
-use crate::windows::spec::replace_windows;
+use crate::windows::spec::{replace_markers, replace_windows};
 
 /// How to render a scene file.
 #[derive(Clone, Debug, Default)]
@@ -111,6 +111,7 @@ impl GpuRun {
         let camera = self.off.camera();
         let pointer = scene.pointer.map(|(x, y, z)| Vec3::new(x, y, z));
         replace_windows(self.off.world_mut(), &scene.windows, &looks, &self.entities, Some(camera), pointer);
+        replace_markers(self.off.world_mut(), &scene.markers, &self.entities);
         let r = scene.rendering;
         self.off.set_view(VolumeView {
             jitter: r.jitter,

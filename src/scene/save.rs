@@ -153,6 +153,7 @@ pub fn scene_file(
         lenses: lenses.to_vec(),
         windows: Vec::new(),
         pointer: None,
+        markers: Vec::new(),
         frames: Vec::new(),
     }
 }

@@ -13,6 +13,7 @@ pub mod objects_panel;
 pub mod orbit;
 pub mod panels;
 pub mod tf_editor;
+pub mod window_tools;
 pub mod windows_panel;
 
 use crate::context::ContextParams;
@@ -43,6 +44,12 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Wheel over a lens", "magnification (rate, field of view)"),
     ("Delete / Esc", "remove the selected lens / stop drawing"),
     ("Drag a clip handle", "move the clip plane along its normal (Clipping panel adds planes)"),
+    ("Hover a window", "focus it: the panels edit its look and parameters"),
+    ("Ctrl+drag a window / source box / dataset", "move it in the plane facing you"),
+    ("Drag a window corner", "resize the focused window (the opposite corner stays)"),
+    ("Right-click a window", "its parameter menu"),
+    ("T", "3D pointer on / off (follows the cursor; wheel: depth; G: onto the surface)"),
+    ("Space / Shift+Space / Backspace", "pointer: place a marker / move the nearest / delete it"),
     ("V", "fly-through on / off (drag: look; arrows, Page Up / Down, wheel: move)"),
     ("Double-click", "centre on the point under the cursor"),
     ("R", "reset the camera"),
@@ -123,6 +130,7 @@ impl Plugin for FocalAppPlugin {
             .init_resource::<PointerInViewport>()
             .init_resource::<lenses::LensUi>()
             .init_resource::<clip_gizmo::ClipGizmo>()
+            .init_resource::<window_tools::WindowTools>()
             .add_systems(
                 Startup,
                 move |mut commands: Commands, mut egui: ResMut<EguiGlobalSettings>, mut load: MessageWriter<LoadRequest>| {
@@ -139,6 +147,7 @@ impl Plugin for FocalAppPlugin {
                     lenses::lens_input,
                     lenses::lens_keys,
                     clip_gizmo::clip_input,
+                    window_tools::window_input,
                     orbit::orbit_input,
                     orbit::fly_keys,
                     shortcuts,

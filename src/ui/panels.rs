@@ -15,13 +15,61 @@ use crate::dataset::{Dataset, GpuVolume, SceneLight, SceneRegions};
 use crate::region::{Light, Lookup, Mode, View};
 use crate::transfer::presets;
 
+fn dataset_row(entity: Entity, d: &Dataset, t: &Transform) -> super::windows_panel::DatasetRow {
+    super::windows_panel::DatasetRow { entity, name: d.volume.name.clone(), appearance: d.appearance.clone(), transform: *t }
+}
+
+/// The focused window's corner handles and its parameter menu (opened by a right-click
+/// on it) beside it.
+fn window_menu(
+    ctx: &egui::Context,
+    free: egui::Rect,
+    p: &mut super::windows_panel::WindowParams,
+    datasets: &DatasetQuery,
+    orbit: &OrbitCamera,
+    regions: &SceneRegions,
+) {
+    let focused = p.focus.0.and_then(|e| p.windows.get(e).ok()).map(|(_, w, g)| crate::windows::systems::window_box(w, g));
+    super::window_tools::overlay(ctx, free, &p.tools, focused, orbit);
+    let Some((e, at)) = p.tools.menu else { return };
+    let mut rows: Vec<_> = datasets.iter().map(|(e, d, _, _, t)| dataset_row(e, d, t)).collect();
+    rows.sort_by_key(|r| r.entity);
+    let (lo, hi) = scene_bounds(regions);
+    let mut open = true;
+    let mut remove = None;
+    egui::Window::new("Window parameters")
+        .id(egui::Id::new(("window_menu", e)))
+        .open(&mut open)
+        .default_pos(free.min + egui::vec2(at.x + 16.0, at.y))
+        .resizable(false)
+        .collapsible(false)
+        .show(ctx, |ui| {
+            if let Ok((_, mut w, g)) = p.windows.get_mut(e)
+                && super::windows_panel::window_settings(ui, &mut w, g, orbit.bevy().0, &rows, (hi - lo).length())
+            {
+                remove = Some(w.source);
+            }
+        });
+    if let Some(source) = remove {
+        super::windows_panel::despawn_window(&mut p.commands, e, source);
+        open = false;
+    }
+    if !open || p.windows.get(e).is_err() {
+        p.tools.menu = None;
+    }
+}
+
+/// The datasets as the panels read and edit them.
+type DatasetQuery<'w, 's> =
+    Query<'w, 's, (Entity, &'static mut Dataset, Option<&'static GpuVolume>, Option<&'static DatasetOrigin>, &'static Transform)>;
+
 /// Everything the panels read and edit.
 #[allow(clippy::too_many_arguments)]
 pub fn ui(
     mut contexts: EguiContexts,
     mut state: ResMut<AppState>,
     mut session: ResMut<Session>,
-    mut datasets: Query<(Entity, &mut Dataset, Option<&GpuVolume>, Option<&DatasetOrigin>, &Transform)>,
+    mut datasets: DatasetQuery,
     loading: Query<&Loading>,
     mut cams: Query<(&mut OrbitCamera, &mut Camera), With<MainCamera>>,
     windows: Query<&Window, With<PrimaryWindow>>,
@@ -124,10 +172,27 @@ pub fn ui(
                         }
                     });
                 }
-                egui::CollapsingHeader::new("Transfer function")
+                // With a window in focus that shows this dataset, the look edited is the
+                // window's own (Borst et al.: panel settings apply to the focused view).
+                let window_look = super::windows_panel::focused_look(&window_params, entity, &d.appearance);
+                let mut in_window = window_look.as_ref().map(|(_, a)| Dataset { appearance: a.clone(), ..(**d).clone() });
+                let (suffix, edited) = match (&window_look, in_window.as_mut()) {
+                    (Some((k, _)), Some(w)) => (format!(" (window {k})"), w),
+                    _ => (String::new(), &mut **d),
+                };
+                egui::CollapsingHeader::new(format!("Transfer function{suffix}"))
+                    .id_salt("transfer")
                     .default_open(true)
-                    .show(ui, |ui| transfer_panel(ui, d, entity, &mut state.editor));
-                egui::CollapsingHeader::new("Rendering").default_open(true).show(ui, |ui| rendering_panel(ui, d, &mut state, &mut light));
+                    .show(ui, |ui| transfer_panel(ui, edited, entity, &mut state.editor));
+                egui::CollapsingHeader::new(format!("Rendering{suffix}"))
+                    .id_salt("rendering")
+                    .default_open(true)
+                    .show(ui, |ui| rendering_panel(ui, edited, &mut state, &mut light));
+                if let (Some((_, before)), Some(w)) = (window_look, in_window)
+                    && w.appearance != before
+                {
+                    super::windows_panel::set_focused_look(&mut window_params, entity, w.appearance);
+                }
                 egui::CollapsingHeader::new("Clipping").default_open(false).show(ui, |ui| {
                     // Planes live in the dataset's frame: the view direction taken there.
                     let view_dir = transform.rotation.inverse() * view_forward;
@@ -141,15 +206,7 @@ pub fn ui(
             }
             egui::CollapsingHeader::new("Lenses").default_open(true).show(ui, |ui| lenses::panel(ui, &mut lens_params));
             egui::CollapsingHeader::new("Volumetric windows").default_open(false).show(ui, |ui| {
-                let rows: Vec<super::windows_panel::DatasetRow> = ds
-                    .iter()
-                    .map(|(e, d, _, _, t)| super::windows_panel::DatasetRow {
-                        entity: *e,
-                        name: d.volume.name.clone(),
-                        appearance: d.appearance.clone(),
-                        transform: **t,
-                    })
-                    .collect();
+                let rows: Vec<_> = ds.iter().map(|(e, d, _, _, t)| dataset_row(*e, d, t)).collect();
                 let (lo, hi) = scene_bounds(&regions);
                 if let Ok((orbit, _)) = cams.single() {
                     super::windows_panel::panel(ui, &mut window_params, &rows, selected, orbit, (hi - lo).length());
@@ -178,6 +235,9 @@ pub fn ui(
         let chosen = rows.get(state.selected.min(rows.len().saturating_sub(1))).copied();
         let camera = cams.single().ok().map(|(o, _)| o.camera());
         super::clip_gizmo::overlay(&ctx, free, &clip_gizmo, chosen, camera);
+    }
+    if let Ok((orbit, _)) = cams.single() {
+        window_menu(&ctx, free, &mut window_params, &datasets, orbit, &regions);
     }
 
     if state.show_help {
@@ -430,9 +490,7 @@ fn mode_name(m: Mode) -> &'static str {
 
 type DatasetRow<'a> = (&'a DatasetOrigin, &'a Dataset, &'a Transform);
 
-fn ds_states<'a>(
-    datasets: &'a Query<(Entity, &mut Dataset, Option<&GpuVolume>, Option<&DatasetOrigin>, &Transform)>,
-) -> Vec<DatasetRow<'a>> {
+fn ds_states<'a>(datasets: &'a DatasetQuery) -> Vec<DatasetRow<'a>> {
     let mut rows: Vec<_> = datasets.iter().filter_map(|(e, d, _, o, t)| o.map(|o| (e, (o, d, t)))).collect();
     rows.sort_by_key(|(e, _)| *e);
     rows.into_iter().map(|(_, r)| r).collect()
@@ -447,7 +505,7 @@ fn save_scene(
     light: Light,
     session: &Session,
     lenses: &[crate::lens::Lens],
-    windows: Vec<crate::windows::spec::WindowSpec>,
+    windows: crate::windows::spec::WindowScene,
 ) -> Result<(), String> {
     use crate::scene::save::{DatasetState, scene_file};
     let states: Vec<DatasetState> = rows
@@ -464,7 +522,9 @@ fn save_scene(
     let camera = camera.ok_or("no camera")?;
     let size = session.scene.as_ref().map(|s| s.size).unwrap_or((512, 512));
     let mut scene = scene_file(&states, &camera, background, light, size, lenses, &session.base);
-    scene.windows = windows;
+    scene.windows = windows.windows;
+    scene.pointer = windows.pointer;
+    scene.markers = windows.markers;
     let path = if path.extension().is_some_and(|e| e == "ron") { path.to_path_buf() } else { path.with_extension("ron") };
     std::fs::write(&path, scene.to_ron()?).map_err(|e| format!("{}: {e}", path.display()))
 }

@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 use super::boxes::OrientedBox;
 use super::components::{Attachment, Automation, Content, Fit, Orientation, Pointer3d, Source, SourceBox, Viewer, VolumeWindow};
 use super::mapping::{coupled_rotation, map_rotation};
+use super::markers::Marker;
 use super::regions::{PlacedContent, PlacedWindow};
 use crate::region::Appearance;
 
@@ -315,4 +316,53 @@ pub fn window_spec(
             Orientation::Window(e) => windows.iter().position(|x| *x == e).map_or(OrientationSpec::Free, OrientationSpec::Window),
         },
     }
+}
+
+/// An interpretive marker in a scene file: a point of a dataset, in the dataset's own
+/// frame (millimetres), so it moves with the dataset.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MarkerSpec {
+    pub dataset: usize,
+    pub position: (f32, f32, f32),
+}
+
+impl MarkerSpec {
+    /// Checks marker `i` against a scene of `datasets` datasets.
+    pub fn validate(&self, i: usize, datasets: usize) -> Result<(), String> {
+        if self.dataset >= datasets {
+            return Err(format!("marker {i}: refers to dataset {}, the scene has {datasets}", self.dataset));
+        }
+        if !vec3(self.position).is_finite() {
+            return Err(format!("marker {i}: position {:?} is not finite", self.position));
+        }
+        Ok(())
+    }
+}
+
+/// The windows, the 3D pointer and the markers of a scene, as saved.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WindowScene {
+    pub windows: Vec<WindowSpec>,
+    pub pointer: Option<(f32, f32, f32)>,
+    pub markers: Vec<MarkerSpec>,
+}
+
+/// Replaces the markers of `world` by a scene's (`datasets`: the dataset entities in the
+/// scene's order; markers of a missing dataset are left out).
+pub fn replace_markers(world: &mut World, markers: &[MarkerSpec], datasets: &[Entity]) {
+    let old: Vec<Entity> = world.query_filtered::<Entity, With<Marker>>().iter(world).collect();
+    for e in old {
+        world.despawn(e);
+    }
+    for m in markers {
+        if let Some(&dataset) = datasets.get(m.dataset) {
+            world.spawn(Marker { dataset, position: vec3(m.position) });
+        }
+    }
+}
+
+/// `marker` as saved: `dataset_index` gives a dataset's index among the saved ones.
+pub fn marker_spec(marker: &Marker, dataset_index: impl Fn(Entity) -> Option<usize>) -> Option<MarkerSpec> {
+    Some(MarkerSpec { dataset: dataset_index(marker.dataset)?, position: marker.position.into() })
 }
