@@ -71,6 +71,26 @@ pub fn vertices(planes: &[Plane]) -> Vec<Vec3> {
     out
 }
 
+/// Whether the convex polyhedron `planes` has volume (its vertices do not all lie in
+/// one plane).
+pub fn has_volume(planes: &[Plane]) -> bool {
+    let v = vertices(planes);
+    if v.len() < 4 {
+        return false;
+    }
+    let (lo, hi) = v.iter().fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), p| (a.min(*p), b.max(*p)));
+    let scale = (hi - lo).max_element().max(1e-6);
+    // Some vertex lies off the plane of three others by a noticeable fraction.
+    let (a, b, c) = (v[0], v[1], v[2]);
+    let mut normal = (b - a).cross(c - a);
+    if normal.length() < 1e-9 * scale * scale {
+        // The first three are collinear: find a non-collinear third.
+        normal = v.iter().map(|p| (b - a).cross(*p - a)).max_by(|x, y| x.length().total_cmp(&y.length())).unwrap_or(Vec3::ZERO);
+    }
+    let len = normal.length();
+    len > 0.0 && v.iter().any(|p| ((*p - a).dot(normal) / len).abs() > 1e-4 * scale)
+}
+
 /// Length of the longest diagonal of a box of `dims` voxels under the linear map
 /// `voxel_to_world` (the largest of its four diagonals).
 pub fn longest_diagonal(voxel_to_world: glam::Mat3, dims: Vec3) -> f32 {

@@ -196,7 +196,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         let objects = pack_objects(p, &slots, &mut out);
         out.regions[index].objects = objects;
     }
-    out.features = scene_features(&out.regions);
+    out.features = scene_features(&out.regions, regions_overlap(&prepared));
     out.max_steps = march_bound(&out.regions[..out.region_count as usize], union_extent(&prepared));
     // Empty scenes still bind (1-texel) atlases.
     out.atlas.size = out.atlas.size.max(UVec3::ONE);
@@ -300,10 +300,26 @@ fn union_extent(prepared: &[PreparedRegion]) -> Option<f32> {
     Some((hi - lo).length())
 }
 
-/// The shader features a list of regions needs.
-pub fn scene_features(regions: &[GpuRegion]) -> u32 {
+/// Whether two of the regions overlap with volume. Only then does the shader need
+/// MULTI_REGION (its sample-by-sample compositing of overlapping regions); regions that
+/// only touch (the pieces of a dataset cut by a clip window, the window inside, two
+/// halves) do without it. On llvmpipe that code costs even where no pixel takes it:
+/// with it a single-region scene ran 40 % slower, and a clip window's seven disjoint
+/// regions ran at a third of the speed.
+fn regions_overlap(prepared: &[PreparedRegion]) -> bool {
+    prepared.iter().enumerate().any(|(i, a)| {
+        prepared[i + 1..].iter().any(|b| {
+            let both: Vec<crate::region::Plane> = a.region.planes.iter().chain(&b.region.planes).copied().collect();
+            crate::region::has_volume(&both)
+        })
+    })
+}
+
+/// The shader features a list of regions needs; `overlapping`: some regions overlap
+/// ([`regions_overlap`]).
+pub fn scene_features(regions: &[GpuRegion], overlapping: bool) -> u32 {
     use super::gpu_types::features as f;
-    let mut bits = if regions.len() > 1 { f::MULTI_REGION } else { 0 };
+    let mut bits = if overlapping { f::MULTI_REGION } else { 0 };
     for r in regions {
         let labels = r.flags & region_flags::LABELS != 0;
         bits |= match r.mode {
@@ -479,6 +495,27 @@ mod tests {
         }
         assert!(longest > 0.5 * bound, "the bound is far too loose: {longest} of {bound}");
         assert!(longest <= bound, "a ray takes {longest} samples, more than the bound {bound}");
+    }
+
+    #[test]
+    fn overlapping_regions_need_the_multi_region_code_touching_ones_do_not() {
+        use super::super::gpu_types::features;
+        let v = Arc::new(phantom::sphere(16, 5.0).unwrap());
+        let tf = presets::builtin("grayscale_ramp").unwrap();
+        let mut scene = RenderScene::single(v.clone(), Appearance::new(Mode::Dvr, tf));
+        let whole = Region::volume_box(&v.grid, 0, 0);
+        let centre = (v.grid.world_bounds().0 + v.grid.world_bounds().1) * 0.5;
+        // Two halves of the volume touch along a plane: no overlap.
+        scene.regions = vec![
+            whole.clone().clipped(Plane::through(centre, glam::Vec3::X)),
+            whole.clone().clipped(Plane::through(centre, -glam::Vec3::X)),
+        ];
+        let packed = pack(&scene, 2048).unwrap();
+        assert_eq!(packed.region_count, 2);
+        assert_eq!(packed.features & features::MULTI_REGION, 0);
+        // The whole volume and one half overlap.
+        scene.regions[0] = whole;
+        assert_ne!(pack(&scene, 2048).unwrap().features & features::MULTI_REGION, 0);
     }
 
     #[test]

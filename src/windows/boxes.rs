@@ -11,7 +11,7 @@
 
 use glam::{Affine3A, Mat3, Quat, Vec3};
 
-use crate::region::{Plane, vertices};
+use crate::region::{Plane, has_volume};
 
 /// A box in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -71,26 +71,6 @@ impl OrientedBox {
     }
 }
 
-/// Whether the convex polyhedron `planes` has volume (its vertices do not all lie in
-/// one plane).
-pub fn has_volume(planes: &[Plane]) -> bool {
-    let v = vertices(planes);
-    if v.len() < 4 {
-        return false;
-    }
-    let (lo, hi) = v.iter().fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), p| (a.min(*p), b.max(*p)));
-    let scale = (hi - lo).max_element().max(1e-6);
-    // Some vertex lies off the plane of three others by a noticeable fraction.
-    let (a, b, c) = (v[0], v[1], v[2]);
-    let mut normal = (b - a).cross(c - a);
-    if normal.length() < 1e-9 * scale * scale {
-        // The first three are collinear: find a non-collinear third.
-        normal = v.iter().map(|p| (b - a).cross(*p - a)).max_by(|x, y| x.length().total_cmp(&y.length())).unwrap_or(Vec3::ZERO);
-    }
-    let len = normal.length();
-    len > 0.0 && v.iter().any(|p| ((*p - a).dot(normal) / len).abs() > 1e-4 * scale)
-}
-
 /// Convex pieces of `region ∖ cut` (see the module doc), each a list of planes.
 pub fn subtract(region: &[Plane], cut: &OrientedBox) -> Vec<Vec<Plane>> {
     let mut with_box = region.to_vec();
@@ -114,6 +94,7 @@ pub fn subtract(region: &[Plane], cut: &OrientedBox) -> Vec<Vec<Plane>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::region::vertices;
 
     fn unit_cube() -> Vec<Plane> {
         OrientedBox::aligned(Vec3::splat(-1.0), Vec3::splat(1.0)).planes()
