@@ -286,3 +286,30 @@ pub fn overlay(ctx: &egui::Context, free: egui::Rect, tools: &WindowTools, focus
 pub fn ray_at(orbit: &OrbitCamera, px: Vec2, size: Vec2) -> Ray {
     orbit.camera().ray(px.x, px.y, size.x.max(1.0) as u32, size.y.max(1.0) as u32)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_moved_window_stays_where_it_was_put_under_each_attachment() {
+        let parent = GlobalTransform::from(Transform::from_xyz(0.0, -300.0, 0.0).with_rotation(Quat::from_rotation_z(0.5)));
+        let target = Vec3::new(10.0, 20.0, 30.0);
+        // Room: the transform moves.
+        let mut w = VolumeWindow::new(Vec3::splat(40.0), vec![]);
+        let mut t = Transform::default();
+        place_window(&mut w, &mut t, target, Some(Vec3::new(20.0, 30.0, 40.0)), None);
+        assert_eq!(t.translation, target);
+        assert_eq!(w.size, Vec3::new(20.0, 30.0, 40.0));
+        // Fixed to the view (or a dataset): the offset in the parent's frame is what
+        // moves, so that attaching puts the window at the target again.
+        let mut w =
+            VolumeWindow { attachment: Attachment::User { offset: Transform::IDENTITY }, ..VolumeWindow::new(Vec3::splat(40.0), vec![]) };
+        let mut t = Transform::from_scale(Vec3::splat(2.0));
+        place_window(&mut w, &mut t, target, Some(Vec3::splat(40.0)), Some(parent));
+        let Attachment::User { offset } = w.attachment else { panic!("the attachment changed") };
+        assert!(parent.transform_point(offset.translation).distance(target) < 1e-3);
+        // The size is the world size over the transform's scale.
+        assert_eq!(w.size, Vec3::splat(20.0));
+    }
+}
