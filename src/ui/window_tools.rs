@@ -92,7 +92,9 @@ pub fn window_input(
     let (Ok(window), Ok((camera, orbit, camera_global))) = (primary.single(), cams.single()) else { return };
     let (origin, size) = viewport_logical(camera, window);
     let cam = orbit.camera();
-    let cursor = window.cursor_position().map(|c| c - origin);
+    // The cursor over the viewport (`pointer_in` is last frame's: the cursor may have
+    // left since, and a ray through a point beside the viewport would take the focus).
+    let cursor = window.cursor_position().map(|c| c - origin).filter(|c| c.cmpge(Vec2::ZERO).all() && c.cmplt(size).all());
     let ray = cursor.filter(|_| pointer_in.inside).map(|c| ray_at(orbit, c, size)).filter(|r| r.dir.is_finite());
     if cursor_ray.0 != ray {
         cursor_ray.0 = ray;
