@@ -448,7 +448,8 @@ fn markers_show_in_every_view_of_their_point() {
     let (magnifier, _clip) = magnifier_and_clip(&mut app, data);
     let pointer = app.world_mut().spawn((Pointer3d, Transform::from_xyz(5.0, 0.0, 0.0))).id();
     app.update();
-    let views = |app: &App, e: Entity| app.world().get::<MarkerViews>(e).map(|v| v.0.clone()).unwrap_or_default();
+    let views =
+        |app: &App, e: Entity| app.world().get::<MarkerViews>(e).map(|v| v.0.iter().map(|m| m.at).collect::<Vec<_>>()).unwrap_or_default();
     let same = |a: &[Vec3], b: &[Vec3]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| close(*x, *y));
     // In the main view at (5, 0, 0): the marker is on the head there, and shows in the
     // magnifier at 200 + 2·(5, 0, 0).

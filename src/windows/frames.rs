@@ -141,24 +141,26 @@ pub fn update_crosses(
     assets: Option<Res<FrameAssets>>,
     views: Query<(&MarkerViews, Has<Pointer3d>)>,
     crosses: Query<Entity, With<ViewCross>>,
-    mut drawn: Local<Vec<(Vec3, bool)>>,
+    mut drawn: Local<Vec<(Vec3, f32, bool)>>,
 ) {
     let Some(assets) = assets else { return };
-    let mut now: Vec<(Vec3, bool)> = views.iter().flat_map(|(v, pointer)| v.0.iter().map(move |p| (*p, pointer))).collect();
-    now.sort_by(|a, b| a.0.to_array().partial_cmp(&b.0.to_array()).unwrap_or(std::cmp::Ordering::Equal).then(a.1.cmp(&b.1)));
+    let mut now: Vec<(Vec3, f32, bool)> = views.iter().flat_map(|(v, pointer)| v.0.iter().map(move |m| (m.at, m.scale, pointer))).collect();
+    now.sort_by(|a, b| a.0.to_array().partial_cmp(&b.0.to_array()).unwrap_or(std::cmp::Ordering::Equal).then(a.2.cmp(&b.2)));
     if *drawn == now {
         return;
     }
     for e in &crosses {
         commands.entity(e).despawn();
     }
-    for &(p, pointer) in &now {
+    for &(p, scale, pointer) in &now {
+        // As large as the view magnifies (small in a world-in-miniature).
         let (material, arm) = if pointer { (&assets.pointer, 2.0 * CROSS_MM) } else { (&assets.marker, CROSS_MM) };
+        let size = Vec3::splat(arm * scale.clamp(0.05, 20.0));
         commands.spawn((
             ViewCross,
             Mesh3d(assets.cross.clone()),
             MeshMaterial3d(material.clone()),
-            Transform::from_translation(p).with_scale(Vec3::splat(arm)),
+            Transform::from_translation(p).with_scale(size),
         ));
     }
     *drawn = now;

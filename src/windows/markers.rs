@@ -22,10 +22,18 @@ pub struct Marker {
     pub position: Vec3,
 }
 
-/// The world points where a marker (or the pointer) shows: the main view's first, then
-/// the windows' in their order. Kept by [`super::systems::propagate_markers`].
+/// One view of a marker: the world point where it shows and its size there (the
+/// window's magnification; 1 in the main view).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MarkerView {
+    pub at: Vec3,
+    pub scale: f32,
+}
+
+/// Where a marker (or the pointer) shows: the main view first, then the windows in
+/// their order. Kept by [`super::systems::propagate_markers`].
 #[derive(Component, Clone, Debug, Default, PartialEq)]
-pub struct MarkerViews(pub Vec<Vec3>);
+pub struct MarkerViews(pub Vec<MarkerView>);
 
 /// A window as placed this frame: its box, its (fitted, coupled) source, whether it
 /// clips, and the datasets it shows.
@@ -41,6 +49,12 @@ impl WindowView {
     /// The data (world) point shown at window point `w`.
     pub fn to_source(&self, w: Vec3) -> Vec3 {
         window_to_source(&self.window, &self.source).transform_point3(w)
+    }
+
+    /// How much the window magnifies (the geometric mean over its axes).
+    pub fn scale(&self) -> f32 {
+        let m = super::mapping::magnification(&self.window, &self.source);
+        (m.x * m.y * m.z).abs().cbrt()
     }
 
     /// The window point that shows data point `p`.
@@ -62,10 +76,10 @@ impl PlacedWindows {
 /// Where data point `p` (world) of `dataset` shows (`None`: of any dataset, as the
 /// pointer): the main view unless a clip window's box holds it, then every window
 /// showing the dataset whose source holds it.
-pub fn views(p: Vec3, dataset: Option<Entity>, windows: &[(Entity, WindowView)]) -> Vec<Vec3> {
+pub fn views(p: Vec3, dataset: Option<Entity>, windows: &[(Entity, WindowView)]) -> Vec<MarkerView> {
     let mut out = Vec::new();
     if !windows.iter().any(|(_, w)| w.clip && w.window.contains(p)) {
-        out.push(p);
+        out.push(MarkerView { at: p, scale: 1.0 });
     }
     for (_, w) in windows {
         if dataset.is_some_and(|d| !w.datasets.contains(&d)) || w.datasets.is_empty() {
@@ -73,7 +87,7 @@ pub fn views(p: Vec3, dataset: Option<Entity>, windows: &[(Entity, WindowView)])
         }
         let q = w.to_window(p);
         if q.is_finite() && w.window.contains(q) {
-            out.push(q);
+            out.push(MarkerView { at: q, scale: w.scale() });
         }
     }
     out
@@ -112,13 +126,17 @@ mod tests {
         let clip_box = OrientedBox { center: Vec3::new(20.0, 0.0, 0.0), rotation: Quat::IDENTITY, half: Vec3::splat(4.0) };
         let clipper = WindowView { window: clip_box, source: clip_box, clip: true, datasets: vec![data] };
         let windows = [(a, magnifier), (b, clipper)];
-        // (1, 2, 3) in the source: main view, and in the magnifier at 100 + 2·(1, 2, 3).
-        assert_eq!(views(Vec3::new(1.0, 2.0, 3.0), Some(data), &windows), vec![Vec3::new(1.0, 2.0, 3.0), Vec3::new(102.0, 4.0, 6.0)]);
+        let at = |v: Vec<MarkerView>| v.iter().map(|v| v.at).collect::<Vec<_>>();
+        // (1, 2, 3) in the source: main view, and in the magnifier at 100 + 2·(1, 2, 3),
+        // twice as large there.
+        let shown = views(Vec3::new(1.0, 2.0, 3.0), Some(data), &windows);
+        assert_eq!(at(shown.clone()), vec![Vec3::new(1.0, 2.0, 3.0), Vec3::new(102.0, 4.0, 6.0)]);
+        assert_eq!((shown[0].scale, shown[1].scale), (1.0, 2.0));
         // Inside the clip box: not in the main view (cut away), in the clip window.
-        assert_eq!(views(Vec3::new(21.0, 0.0, 0.0), Some(data), &windows), vec![Vec3::new(21.0, 0.0, 0.0)]);
+        assert_eq!(views(Vec3::new(21.0, 0.0, 0.0), Some(data), &windows), vec![MarkerView { at: Vec3::new(21.0, 0.0, 0.0), scale: 1.0 }]);
         // Another dataset's marker shows in the main view only.
         let other = Entity::from_raw_u32(7).unwrap();
-        assert_eq!(views(Vec3::new(1.0, 2.0, 3.0), Some(other), &windows), vec![Vec3::new(1.0, 2.0, 3.0)]);
+        assert_eq!(at(views(Vec3::new(1.0, 2.0, 3.0), Some(other), &windows)), vec![Vec3::new(1.0, 2.0, 3.0)]);
         // Reaching into the magnifier at (104, 0, 0) points at data (2, 0, 0).
         assert_eq!(data_point(Vec3::new(104.0, 0.0, 0.0), &windows), (Vec3::new(2.0, 0.0, 0.0), Some(a)));
         assert_eq!(data_point(Vec3::new(50.0, 0.0, 0.0), &windows), (Vec3::new(50.0, 0.0, 0.0), None));

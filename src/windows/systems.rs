@@ -10,7 +10,7 @@ use super::boxes::OrientedBox;
 use super::components::{Attachment, Orientation, Pointer3d, Source, SourceBox, Viewer, VolumeWindow};
 use super::interaction::focus;
 use super::mapping::{coupled_rotation, map_rotation};
-use super::markers::{Marker, MarkerViews, PlacedWindows, WindowView, data_point, views};
+use super::markers::{Marker, MarkerView, MarkerViews, PlacedWindows, WindowView, data_point, views};
 use super::regions::{PlacedContent, PlacedWindow, add_windows};
 use crate::dataset::{Dataset, GpuVolume, SceneRegions};
 use crate::region::Ray;
@@ -165,7 +165,7 @@ pub fn propagate_markers(
     mut markers: Query<(Entity, &Marker, Option<&mut MarkerViews>), Without<Pointer3d>>,
     mut pointers: Query<(Entity, &GlobalTransform, Option<&mut MarkerViews>), (With<Pointer3d>, Without<Marker>)>,
 ) {
-    let mut set = |e: Entity, shown: Vec<Vec3>, old: Option<Mut<MarkerViews>>| match old {
+    let mut set = |e: Entity, shown: Vec<MarkerView>, old: Option<Mut<MarkerViews>>| match old {
         Some(mut v) if v.0 != shown => v.0 = shown,
         Some(_) => {}
         None => {
