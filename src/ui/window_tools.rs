@@ -160,35 +160,32 @@ pub fn window_input(
             tools.drag = Some(Drag::Resize { window: e, start: b, corner: c });
         } else if ctrl {
             // The nearest window or source box under the cursor, else the nearest
-            // dataset (its box; its origin is what moves).
-            let nearest = |boxes: Vec<(Entity, OrientedBox, Vec3)>| {
-                boxes
-                    .into_iter()
-                    .filter_map(|(e, b, centre)| ray_box(&r, &b).map(|(t0, _)| (e, centre, r.at(t0.max(0.0)))))
-                    .min_by(|a, b| a.2.distance_squared(r.origin).total_cmp(&b.2.distance_squared(r.origin)))
+            // dataset (its box, met in its own frame; its origin is what moves). A hit is
+            // (entity, the point that moves, where the ray enters).
+            let enters = |ray: &Ray, b: &OrientedBox| ray_box(ray, b).map(|(t0, _)| r.at(t0.max(0.0)));
+            let nearest = |hits: Vec<(Entity, Vec3, Vec3)>| {
+                hits.into_iter().min_by(|a, b| a.2.distance_squared(r.origin).total_cmp(&b.2.distance_squared(r.origin)))
             };
-            let tools_boxes: Vec<_> = placed
+            let tool_hits = placed
                 .0
                 .iter()
-                .map(|(e, v)| (*e, v.window, v.window.center))
-                .chain(sources.iter().map(|(e, s, _, g)| {
-                    let b = window_box(&VolumeWindow::new(s.size, vec![]), g);
-                    (e, b, b.center)
-                }))
+                .map(|(e, v)| (*e, v.window))
+                .chain(sources.iter().map(|(e, s, _, g)| (e, window_box(&VolumeWindow::new(s.size, vec![]), g))))
+                .filter_map(|(e, b)| enters(&r, &b).map(|at| (e, b.center, at)))
                 .collect();
-            let data_boxes = || {
+            let data_hits = || {
                 datasets
                     .iter()
-                    .map(|(e, d, t, g)| {
+                    .filter_map(|(e, d, _, g)| {
                         let (lo, hi) = d.volume.grid.world_bounds();
-                        let local = OrientedBox::aligned(lo, hi);
-                        let (_, rotation, _) = g.to_scale_rotation_translation();
-                        let b = OrientedBox { center: g.transform_point(local.center), rotation, half: local.half * t.scale.abs() };
-                        (e, b, g.translation())
+                        let to_local = g.affine().inverse();
+                        // (The same ray parameter in both frames: the direction is mapped, not normalised.)
+                        let local = Ray { origin: to_local.transform_point3(r.origin), dir: to_local.transform_vector3(r.dir) };
+                        enters(&local, &OrientedBox::aligned(lo, hi)).map(|at| (e, g.translation(), at))
                     })
                     .collect()
             };
-            let hit = nearest(tools_boxes).or_else(|| nearest(data_boxes()));
+            let hit = nearest(tool_hits).or_else(|| nearest(data_hits()));
             if let Some((target, centre, anchor)) = hit {
                 tools.drag = Some(Drag::Move { target, anchor, offset: centre - anchor });
             }

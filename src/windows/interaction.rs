@@ -9,7 +9,7 @@
 //! a cursor in the view (it is over the panels) the focus stays, so the panels edit the
 //! window that was last pointed at.
 
-use glam::{Vec3, Vec3Swizzles};
+use glam::Vec3;
 
 use super::boxes::OrientedBox;
 use crate::region::Ray;
@@ -102,11 +102,6 @@ pub fn corner_under(b: &OrientedBox, ray: &Ray, tolerance: f32) -> Option<usize>
 pub fn pixels_to_world(pixels: f32, height: f32, view_height: f32, eye: Option<Vec3>, p: Vec3) -> f32 {
     let distance = eye.map_or(1.0, |e| e.distance(p));
     pixels / height.max(1.0) * view_height * distance
-}
-
-/// The largest of a box's extents (for handle sizes and marker radii).
-pub fn box_scale(b: &OrientedBox) -> f32 {
-    2.0 * b.half.xyz().max_element()
 }
 
 #[cfg(test)]

@@ -40,6 +40,11 @@ pub struct PlacedContent {
 }
 
 impl PlacedWindow {
+    /// The window with the fit automation applied to its source (then `fit` is `None`).
+    pub fn fitted(self) -> PlacedWindow {
+        PlacedWindow { source: self.fitted_source(), fit: None, ..self }
+    }
+
     /// The source box after the fit automation.
     pub fn fitted_source(&self) -> OrientedBox {
         match self.fit {

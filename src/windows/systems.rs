@@ -114,10 +114,11 @@ pub fn window_regions(
                 Some(PlacedContent { volume, volume_index, dataset_to_world: g.affine(), appearance })
             })
             .collect();
-        let p = PlacedWindow { window, source, fit: w.automation.fit, clip: w.clip, contents };
+        // The fit once: the placed window carries its fitted source.
+        let fitted = PlacedWindow { window, source, fit: w.automation.fit, clip: w.clip, contents }.fitted();
         let shown = w.contents.iter().map(|c| c.dataset).filter(|d| datasets.contains(*d)).collect();
-        placed_views.push((*e, WindowView { window, source: p.fitted_source(), clip: w.clip, datasets: shown }));
-        placed.push(p);
+        placed_views.push((*e, WindowView { window, source: fitted.source, clip: w.clip, datasets: shown }));
+        placed.push(fitted);
     }
     views.0 = placed_views;
     add_windows(&mut scene, dataset_regions, &placed);
