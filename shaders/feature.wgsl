@@ -14,7 +14,7 @@
 
 #import focal::types::Region
 #import focal::bindings::regions
-#import focal::regions::{region_interval, to_voxel}
+#import focal::regions::{region_interval, in_hole, to_voxel}
 #import focal::sampling::nearest_code
 #import focal::lens::camera_ray
 
@@ -60,7 +60,8 @@ fn marches_into_feature(uv: vec2<f32>) -> bool {
     let span = region_interval(r, ray.origin, ray.dir);
     var t = max(span.x, 0.0) + 0.5 * job.step;
     for (var k = 0u; k < MAX_MARCH && t < span.y; k++) {
-        if nearest_code(r, to_voxel(r, ray.origin + ray.dir * t)) == job.label {
+        let p = ray.origin + ray.dir * t;
+        if nearest_code(r, to_voxel(r, p)) == job.label && !in_hole(r, p) {
             return true;
         }
         t += job.step;

@@ -36,7 +36,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 10] = [
+const DEFS: [&str; 11] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -47,6 +47,7 @@ const DEFS: [&str; 10] = [
     "HAS_LENSES",
     "HAS_CONTEXT",
     "HAS_TWO_LEVEL",
+    "DVR_PAIRS",
 ];
 
 #[test]

@@ -13,6 +13,9 @@ struct Region {
     brick_offset: vec4<u32>,
     plane_offset: u32,
     plane_count: u32,
+    // Boxes cut out of the region (clip windows): six planes each from hole_offset.
+    hole_offset: u32,
+    hole_count: u32,
     mode: u32,
     flags: u32,
     lut_offset: u32,
@@ -34,6 +37,8 @@ struct Region {
     context: vec4<f32>,
     // World bounding sphere of the volume's box (centre, radius).
     sphere: vec4<f32>,
+    // World bounding sphere of the region's polyhedron (centre, radius).
+    bounds: vec4<f32>,
     // Segmented regions: first part record, part count, label record.
     objects: vec4<u32>,
 }

@@ -292,16 +292,17 @@ pub fn feature_mask(scene: &RenderScene, job: &FeatureJob, camera: &Camera, scre
             let px = (x as f32 + 0.5) / cols as f32 * screen.width;
             let py = (y as f32 + 0.5) / rows as f32 * screen.height;
             let ray = camera.ray(px, py, screen.width as u32, screen.height as u32);
-            let Some((t0, t1)) = region.intersect(ray.origin, ray.dir) else { return false };
-            let mut t = t0.max(0.0) + 0.5 * step;
-            while t < t1 {
-                let q: Vec3 = region.world_to_voxel.transform_point3(ray.at(t));
-                if sampler.nearest(q) as u32 == label {
-                    return true;
+            region.intersect(ray.origin, ray.dir).into_iter().any(|(t0, t1)| {
+                let mut t = t0.max(0.0) + 0.5 * step;
+                while t < t1 {
+                    let q: Vec3 = region.world_to_voxel.transform_point3(ray.at(t));
+                    if sampler.nearest(q) as u32 == label {
+                        return true;
+                    }
+                    t += step;
                 }
-                t += step;
-            }
-            false
+                false
+            })
         })
         .collect()
 }

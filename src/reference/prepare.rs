@@ -151,6 +151,16 @@ impl<'a> PreparedRegion<'a> {
         }
     }
 
+    /// The region cut to the box of the bricks its appearance makes visible (its
+    /// occupancy): outside that box every full-resolution sample is transparent. The
+    /// region itself when there is no occupancy or nothing is visible.
+    pub fn visible_part(&self) -> std::borrow::Cow<'_, Region> {
+        let Some((bricks, occupied)) = &self.occupancy else { return std::borrow::Cow::Borrowed(self.region) };
+        let Some((lo, hi)) = bricks.bounds_where(occupied) else { return std::borrow::Cow::Borrowed(self.region) };
+        let dims = self.volume.dims().as_vec3();
+        std::borrow::Cow::Owned(self.region.cut_to_index_box(lo.max(Vec3::splat(-0.5)), hi.min(dims - 0.5)))
+    }
+
     /// World step that advances `native_step` in the volume along `dir`.
     pub fn world_step(&self, dir: Vec3) -> f32 {
         let scale = (self.to_native * dir).length().max(1e-9);

@@ -1,6 +1,7 @@
 //! The per-pixel function: one ray through every region, front to back.
 //!
-//! 1. Intersect the ray with each region: intervals `[t0, t1]` (clamped to `t ≥ 0`).
+//! 1. Intersect the ray with each region: intervals `[t0, t1]` (clamped to `t ≥ 0`); a
+//!    region with holes (clip windows) has one interval more per hole it splits.
 //! 2. March one sample sequence over the union, `t_k = t_start + (k + j)·Δ`, with `Δ` the
 //!    smallest world step of the regions on the ray and `j` the jitter offset (0.5 without
 //!    jitter: the midpoint rule, so an axis-aligned ray with `Δ` = one voxel samples the
@@ -78,9 +79,11 @@ impl Gathered {
     const EMPTY: Gathered = Gathered { max: f32::NEG_INFINITY, min: f32::INFINITY, sum: 0.0, count: 0, prev: None, done: false };
 }
 
-/// Per-region state along the ray.
+/// State along the ray of one interval of a region (a region with holes has several).
 #[derive(Clone, Copy)]
 struct State {
+    /// Index of the region.
+    region: usize,
     t0: f32,
     t1: f32,
     gathered: Gathered,
@@ -118,25 +121,27 @@ pub fn trace_antialiased(
     footprint: Option<&Footprint>,
 ) -> Traced {
     let mut out = Traced { color: Vec4::ZERO, value: f32::NAN, depth: f32::INFINITY, region: None, samples: 0 };
-    let mut states: Vec<Option<State>> = Vec::with_capacity(regions.len());
+    // The intervals of every region (in region order, each region's in increasing t).
+    let mut states: Vec<State> = Vec::with_capacity(regions.len());
     let (mut t_start, mut t_end, mut step) = (f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY);
-    for r in regions {
-        let s = r.region.intersect(ray.origin, ray.dir).map(|(a, b)| (a.max(0.0), b)).filter(|(a, b)| a < b);
-        if let Some((t0, t1)) = s {
+    for (region, r) in regions.iter().enumerate() {
+        let before = states.len();
+        for (t0, t1) in r.region.intersect(ray.origin, ray.dir).into_iter().map(|(a, b)| (a.max(0.0), b)).filter(|(a, b)| a < b) {
             t_start = t_start.min(t0);
             t_end = t_end.max(t1);
+            states.push(State { region, t0, t1, gathered: Gathered::EMPTY, done: false, part: None, ratio: 0.0 });
+        }
+        if states.len() > before {
             step = step.min(r.world_step(ray.dir));
         }
-        states.push(s.map(|(t0, t1)| State { t0, t1, gathered: Gathered::EMPTY, done: false, part: None, ratio: 0.0 }));
     }
     if !t_start.is_finite() {
         return out;
     }
     let footprint = footprint.map(|f| f.over(t_start, t_end));
-    for (st, r) in states.iter_mut().zip(regions) {
-        if let Some(st) = st {
-            st.ratio = r.native_step * (step / r.world_step(ray.dir)) / r.reference_length;
-        }
+    for st in &mut states {
+        let r = &regions[st.region];
+        st.ratio = r.native_step * (step / r.world_step(ray.dir)) / r.reference_length;
     }
     let stop = if stop_at_depth { depth_threshold } else { EARLY_TERMINATION };
     let mut k = 0u32;
@@ -149,8 +154,8 @@ pub fn trace_antialiased(
         out.samples = k;
         let p = ray.at(t);
         let at = Sampling { ray: &ray, light, level: footprint.map_or(0.0, |f| f.level(t, MIP_LEVELS as f32)), depth_threshold };
-        for (i, r) in regions.iter().enumerate() {
-            let Some(st) = states[i].as_mut() else { continue };
+        for st in &mut states {
+            let (i, r) = (st.region, &regions[st.region]);
             if st.done {
                 continue;
             }
@@ -196,12 +201,9 @@ pub fn trace_antialiased(
         }
     }
     // Projections (and segments) still open at the end of the march.
-    for (i, r) in regions.iter().enumerate() {
-        if let Some(st) = states[i].as_mut()
-            && !st.done
-            && out.color.w < stop
-        {
-            close(&mut out, r, st, st.t1, i, depth_threshold);
+    for st in &mut states {
+        if !st.done && out.color.w < stop {
+            close(&mut out, &regions[st.region], st, st.t1, st.region, depth_threshold);
         }
     }
     out

@@ -71,6 +71,26 @@ pub fn vertices(planes: &[Plane]) -> Vec<Vec3> {
     out
 }
 
+/// The planes of the convex polyhedron `planes` that bound it: those with a face (three
+/// vertices or more on them, of which two planes with the same face keep the first).
+/// A polyhedron without volume is returned as it is.
+pub fn bounding_planes(planes: &[Plane]) -> Vec<Plane> {
+    let corners = vertices(planes);
+    if !has_volume(planes) {
+        return planes.to_vec();
+    }
+    let scale = corners.iter().map(|p| p.length()).fold(1.0, f32::max);
+    let on = |pl: &Plane| corners.iter().filter(|p| pl.distance(**p).abs() <= 1e-4 * scale).count() >= 3;
+    let mut out: Vec<Plane> = Vec::new();
+    for pl in planes.iter().filter(|pl| on(pl)) {
+        let same = |q: &Plane| (q.normal - pl.normal).length() < 1e-5 && (q.offset - pl.offset).abs() <= 1e-4 * scale;
+        if !out.iter().any(same) {
+            out.push(*pl);
+        }
+    }
+    out
+}
+
 /// Whether the convex polyhedron `planes` has volume (its vertices do not all lie in
 /// one plane).
 pub fn has_volume(planes: &[Plane]) -> bool {
@@ -100,10 +120,14 @@ pub fn longest_diagonal(voxel_to_world: glam::Mat3, dims: Vec3) -> f32 {
         .fold(0.0, f32::max)
 }
 
-/// A convex region of space showing one volume through an affine map.
+/// A convex region of space showing one volume through an affine map, less any holes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Region {
     pub planes: Vec<Plane>,
+    /// Boxes cut out of the region (clip windows), six half-spaces each, normals out.
+    /// A ray meets the region in its interval with the convex part less each hole's
+    /// interval: at most one interval more per hole ([`subtract_interval`]).
+    pub holes: Vec<[Plane; 6]>,
     /// World position → continuous voxel index of the volume.
     pub world_to_voxel: Affine3A,
     /// Index of the volume in the scene.
@@ -122,7 +146,13 @@ impl Region {
     /// own space → world).
     pub fn volume_box_at(grid: &Grid, transform: Affine3A, volume: usize, appearance: usize) -> Region {
         let world_to_voxel = grid.world_to_index() * transform.inverse();
-        Region { planes: box_planes(&world_to_voxel, Vec3::splat(-0.5), grid.dims.as_vec3() - 0.5), world_to_voxel, volume, appearance }
+        Region {
+            planes: box_planes(&world_to_voxel, Vec3::splat(-0.5), grid.dims.as_vec3() - 0.5),
+            holes: Vec::new(),
+            world_to_voxel,
+            volume,
+            appearance,
+        }
     }
 
     /// A dataset's region: its volume's box placed by `transform`, cut by its clipping
@@ -133,21 +163,49 @@ impl Region {
         region
     }
 
+    /// The region cut to the continuous voxel-index box `[lo, hi]` of its volume;
+    /// planes that no longer bound it are dropped (so the box's planes replace the
+    /// volume's, not add to them).
+    pub fn cut_to_index_box(&self, lo: Vec3, hi: Vec3) -> Region {
+        let mut planes = self.planes.clone();
+        planes.extend(box_planes(&self.world_to_voxel, lo, hi));
+        Region { planes: bounding_planes(&planes), ..self.clone() }
+    }
+
     /// Adds a cutting plane (keeps the part with `normal · p ≤ offset`).
     pub fn clipped(mut self, plane: Plane) -> Region {
         self.planes.push(plane);
         self
     }
 
-    /// Whether a world point lies inside (on the boundary counts as inside).
+    /// Whether a world point lies inside (on the boundary counts as inside; inside a
+    /// hole, off its boundary, does not).
     pub fn contains(&self, p: Vec3) -> bool {
-        self.planes.iter().all(|pl| pl.distance(p) <= 1e-5)
+        self.planes.iter().all(|pl| pl.distance(p) <= 1e-5) && !self.holes.iter().any(|h| h.iter().all(|pl| pl.distance(p) < -1e-5))
     }
 
-    /// The parameter interval `[t0, t1]` of `origin + t·dir` inside the region, if any.
-    pub fn intersect(&self, origin: Vec3, dir: Vec3) -> Option<(f32, f32)> {
-        ray_convex(&self.planes, origin, dir)
+    /// The parameter intervals of `origin + t·dir` inside the region, in increasing
+    /// order: the convex part's interval less each hole's.
+    pub fn intersect(&self, origin: Vec3, dir: Vec3) -> Vec<(f32, f32)> {
+        let Some(whole) = ray_convex(&self.planes, origin, dir) else { return Vec::new() };
+        let mut out = vec![whole];
+        for hole in &self.holes {
+            if let Some(cut) = ray_convex(hole, origin, dir) {
+                out = out.into_iter().flat_map(|iv| subtract_interval(iv, cut)).collect();
+            }
+        }
+        out
     }
+}
+
+/// `[a, b]` less the open interval `(c, d)`: none, one or two closed intervals (the
+/// shader does the same in `region_intervals`).
+pub fn subtract_interval((a, b): (f32, f32), (c, d): (f32, f32)) -> impl Iterator<Item = (f32, f32)> {
+    let overlaps = c < b && d > a && c < d;
+    let left = (overlaps && c > a).then_some((a, c));
+    let right = (overlaps && d < b).then_some((d, b));
+    let whole = (!overlaps).then_some((a, b));
+    whole.into_iter().chain(left).chain(right)
 }
 
 /// Clips a ray against a convex set of half-spaces (Cyrus–Beck / Kay–Kajiya slabs):
@@ -203,13 +261,54 @@ mod tests {
     fn ray_box_entry_and_exit() {
         let g = Grid::new(UVec3::new(10, 10, 10), Vec3::splat(2.0)); // box from −1 to 19 mm
         let r = Region::volume_box(&g, 0, 0);
-        let (t0, t1) = r.intersect(Vec3::new(-11.0, 5.0, 5.0), Vec3::X).unwrap();
+        let (t0, t1) = r.intersect(Vec3::new(-11.0, 5.0, 5.0), Vec3::X)[0];
         assert!((t0 - 10.0).abs() < 1e-5 && (t1 - 30.0).abs() < 1e-5, "{t0} {t1}");
-        assert!(r.intersect(Vec3::new(-11.0, 25.0, 5.0), Vec3::X).is_none());
+        assert!(r.intersect(Vec3::new(-11.0, 25.0, 5.0), Vec3::X).is_empty());
         // Parallel ray outside a slab misses; inside it hits.
-        assert!(r.intersect(Vec3::new(5.0, -5.0, 5.0), Vec3::Z).is_none());
+        assert!(r.intersect(Vec3::new(5.0, -5.0, 5.0), Vec3::Z).is_empty());
         assert!(r.contains(Vec3::new(0.0, 0.0, 0.0)));
         assert!(!r.contains(Vec3::new(-1.5, 0.0, 0.0)));
+    }
+
+    #[test]
+    fn cutting_to_an_index_box_replaces_the_box_planes() {
+        // Voxels 0..9 at 1 mm: the box −0.5 … 9.5; cut to voxels 2 … 5 (1.5 … 5.5 mm along
+        // x, the whole box otherwise) with a clip plane at y ≤ 7 kept.
+        let g = Grid::new(glam::UVec3::splat(10), Vec3::ONE);
+        let r = Region::volume_box(&g, 0, 0).clipped(Plane::through(Vec3::new(0.0, 7.0, 0.0), Vec3::Y));
+        let cut = r.cut_to_index_box(Vec3::new(1.5, -0.5, -0.5), Vec3::new(5.5, 9.5, 9.5));
+        assert_eq!(cut.planes.len(), 6, "{:?}", cut.planes);
+        let (t0, t1) = cut.intersect(Vec3::new(-10.0, 4.0, 4.0), Vec3::X)[0];
+        assert!((t0 - 11.5).abs() < 1e-4 && (t1 - 15.5).abs() < 1e-4, "{t0} {t1}");
+        let (_, t1) = cut.intersect(Vec3::new(3.0, -10.0, 4.0), Vec3::Y)[0];
+        assert!((t1 - 17.0).abs() < 1e-4, "the clip plane stays: {t1}");
+        // Redundant planes go, whatever their order; a face's twin is kept once.
+        let twice: Vec<Plane> = r.planes.iter().chain(&r.planes).copied().collect();
+        assert_eq!(bounding_planes(&twice).len(), 6);
+    }
+
+    #[test]
+    fn holes_split_intervals_and_points() {
+        // By hand: [0, 10] less (2, 4) is [0, 2] and [4, 10]; less (−1, 3): [3, 10];
+        // less (8, 12): [0, 8]; less (−1, 11): nothing; less (11, 12): itself.
+        let cut = |c| subtract_interval((0.0, 10.0), c).collect::<Vec<_>>();
+        assert_eq!(cut((2.0, 4.0)), vec![(0.0, 2.0), (4.0, 10.0)]);
+        assert_eq!(cut((-1.0, 3.0)), vec![(3.0, 10.0)]);
+        assert_eq!(cut((8.0, 12.0)), vec![(0.0, 8.0)]);
+        assert!(cut((-1.0, 11.0)).is_empty());
+        assert_eq!(cut((11.0, 12.0)), vec![(0.0, 10.0)]);
+        // A box of voxels 0..9 (−0.5 … 9.5 mm) with the cube 3..5 mm cut out: a ray along
+        // x through the hole meets [−0.5, 3] and [5, 9.5]; one beside it the whole box.
+        let g = Grid::new(glam::UVec3::splat(10), Vec3::ONE);
+        let mut r = Region::volume_box(&g, 0, 0);
+        let hole = box_planes(&glam::Affine3A::IDENTITY, Vec3::splat(3.0), Vec3::splat(5.0));
+        r.holes.push(std::array::from_fn(|i| hole[i]));
+        let through = r.intersect(Vec3::new(-10.0, 4.0, 4.0), Vec3::X);
+        assert_eq!(through.len(), 2);
+        assert!((through[0].0 - 9.5).abs() < 1e-5 && (through[0].1 - 13.0).abs() < 1e-5, "{through:?}");
+        assert!((through[1].0 - 15.0).abs() < 1e-5 && (through[1].1 - 19.5).abs() < 1e-5, "{through:?}");
+        assert_eq!(r.intersect(Vec3::new(-10.0, 6.0, 4.0), Vec3::X).len(), 1);
+        assert!(!r.contains(Vec3::splat(4.0)) && r.contains(Vec3::new(4.0, 6.0, 4.0)) && r.contains(Vec3::new(3.0, 4.0, 4.0)));
     }
 
     #[test]
@@ -219,15 +318,15 @@ mod tests {
         let g = Grid::from_axes(UVec3::new(4, 2, 2), axes, Vec3::ZERO).unwrap();
         let r = Region::volume_box(&g, 0, 0);
         // Along world y the box spans index x from −0.5 to 3.5.
-        let (t0, t1) = r.intersect(Vec3::new(0.0, -10.0, 0.5), Vec3::Y).unwrap();
+        let (t0, t1) = r.intersect(Vec3::new(0.0, -10.0, 0.5), Vec3::Y)[0];
         assert!((t0 - 9.5).abs() < 1e-5 && (t1 - 13.5).abs() < 1e-5, "{t0} {t1}");
         // Clip away y > 1.
         let c = r.clipped(Plane::through(Vec3::new(0.0, 1.0, 0.0), Vec3::Y));
-        let (_, t1) = c.intersect(Vec3::new(0.0, -10.0, 0.5), Vec3::Y).unwrap();
+        let (_, t1) = c.intersect(Vec3::new(0.0, -10.0, 0.5), Vec3::Y)[0];
         assert!((t1 - 11.0).abs() < 1e-5);
         // Moved 5 mm along y: the box moves with it, and so does the voxel map.
         let moved = Region::volume_box_at(&g, Affine3A::from_translation(Vec3::Y * 5.0), 0, 0);
-        let (t0, _) = moved.intersect(Vec3::new(0.0, -10.0, 0.5), Vec3::Y).unwrap();
+        let (t0, _) = moved.intersect(Vec3::new(0.0, -10.0, 0.5), Vec3::Y)[0];
         assert!((t0 - 14.5).abs() < 1e-5, "{t0}");
         assert!((moved.world_to_voxel.transform_point3(Vec3::new(0.0, 5.0, 0.0)) - Vec3::ZERO).length() < 1e-5);
         assert_eq!(Plane::through(Vec3::ONE, Vec3::X).flipped().distance(Vec3::ZERO), 1.0);

@@ -55,9 +55,11 @@ pub mod features {
     pub const CONTEXT: u32 = 256;
     /// Two-level rendering of segmented volumes.
     pub const TWO_LEVEL: u32 = 512;
+    /// Two DVR-like regions overlap: the DVR loop takes both at each sample.
+    pub const DVR_PAIRS: u32 = 1024;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 10] = [
+    pub const NAMES: [(u32, &str); 11] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -68,6 +70,7 @@ pub mod features {
         (LENSES, "HAS_LENSES"),
         (CONTEXT, "HAS_CONTEXT"),
         (TWO_LEVEL, "HAS_TWO_LEVEL"),
+        (DVR_PAIRS, "DVR_PAIRS"),
     ];
 }
 
@@ -102,6 +105,9 @@ pub struct GpuRegion {
     pub brick_offset: UVec4,
     pub plane_offset: u32,
     pub plane_count: u32,
+    /// Boxes cut out of the region: `hole_count` × six planes from `hole_offset`.
+    pub hole_offset: u32,
+    pub hole_count: u32,
     pub mode: u32,
     pub flags: u32,
     pub lut_offset: u32,
@@ -124,6 +130,9 @@ pub struct GpuRegion {
     pub context: Vec4,
     /// World bounding sphere of the volume's box (centre, radius).
     pub sphere: Vec4,
+    /// World bounding sphere of the region's polyhedron (centre, radius; an infinite
+    /// radius when it has no vertices): rays that miss it skip the region's planes.
+    pub bounds: Vec4,
     /// Segmented regions ([`mode::TWO_LEVEL`]): index of the first part record (the
     /// objects, then the rest), the number of parts, and the index of the label
     /// record (the label volume with, per code, up to four candidate objects + 1).

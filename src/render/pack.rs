@@ -196,7 +196,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         let objects = pack_objects(p, &slots, &mut out);
         out.regions[index].objects = objects;
     }
-    out.features = scene_features(&out.regions, regions_overlap(&prepared));
+    out.features = scene_features(&out.regions, overlaps(&prepared));
     out.max_steps = march_bound(&out.regions[..out.region_count as usize], union_extent(&prepared));
     // Empty scenes still bind (1-texel) atlases.
     out.atlas.size = out.atlas.size.max(UVec3::ONE);
@@ -260,6 +260,8 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
 /// proportion to the constant (1 000: 0.1 s, 16 384: 0.9 s, 65 535: 3.5 s) while no
 /// visible pixel reached it, so lanes that are never written (llvmpipe reports 4 352
 /// invocations for 4 096 pixels) ran each loop to llvmpipe's own 65 535-iteration limit.
+/// (Those lanes' rays have a NaN step; the shader now returns at once for them, which
+/// made frames four times faster again, but the bound stays as the guard.)
 ///
 /// The bound: a ray samples every region it crosses at its step, the smallest world step
 /// of those regions (`raycast.wgsl`), so it takes at most Σ chord_r / min_r step_r + 1
@@ -267,10 +269,10 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
 /// the box's longest diagonal; a region's smallest world step is native_step / σ_max of
 /// its world→native map, and the Frobenius norm bounds σ_max from above. The samples of
 /// one ray also lie between its first entry and last exit, so `extent` (the diagonal of
-/// the regions' bounding box) bounds the chords' sum too: many small regions (a clip
-/// window cuts a dataset into six pieces) would otherwise multiply the bound, and with it
-/// the time llvmpipe's idle lanes spin. The outer loop also stops once per gap and
-/// region boundary: 2 more per region, and 2 spare.
+/// the regions' bounding box) bounds the chords' sum too: many small regions (the parts
+/// of an exploded view) would otherwise multiply the bound. The outer loop also stops
+/// once per gap and interval boundary: 3 more per region and per hole (a hole splits an
+/// interval in two), and 2 spare.
 pub fn march_bound(regions: &[GpuRegion], extent: Option<f32>) -> u32 {
     let mut chords = 0.0f64;
     let mut step = f64::INFINITY;
@@ -287,7 +289,8 @@ pub fn march_bound(regions: &[GpuRegion], extent: Option<f32>) -> u32 {
     if regions.is_empty() || !chords.is_finite() || step.is_nan() || step <= 0.0 {
         return 2;
     }
-    let bound = (chords / step).ceil() + 3.0 * regions.len() as f64 + 2.0;
+    let intervals = regions.len() + regions.iter().map(|r| r.hole_count as usize).sum::<usize>();
+    let bound = (chords / step).ceil() + 3.0 * intervals as f64 + 2.0;
     bound.min(u32::MAX as f64) as u32
 }
 
@@ -300,26 +303,65 @@ fn union_extent(prepared: &[PreparedRegion]) -> Option<f32> {
     Some((hi - lo).length())
 }
 
-/// Whether two of the regions overlap with volume. Only then does the shader need
-/// MULTI_REGION (its sample-by-sample compositing of overlapping regions); regions that
-/// only touch (the pieces of a dataset cut by a clip window, the window inside, two
-/// halves) do without it. On llvmpipe that code costs even where no pixel takes it:
-/// with it a single-region scene ran 40 % slower, and a clip window's seven disjoint
-/// regions ran at a third of the speed.
-fn regions_overlap(prepared: &[PreparedRegion]) -> bool {
-    prepared.iter().enumerate().any(|(i, a)| {
-        prepared[i + 1..].iter().any(|b| {
-            let both: Vec<crate::region::Plane> = a.region.planes.iter().chain(&b.region.planes).copied().collect();
-            crate::region::has_volume(&both)
-        })
-    })
+/// How the regions overlap, which decides the compositing code the shader needs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Overlaps {
+    /// Two DVR-like regions overlap (DVR_PAIRS: the DVR loop takes both at each sample).
+    pub dvr_pairs: bool,
+    /// Other regions overlap, or three at once (MULTI_REGION: sample by sample).
+    pub general: bool,
 }
 
-/// The shader features a list of regions needs; `overlapping`: some regions overlap
-/// ([`regions_overlap`]).
-pub fn scene_features(regions: &[GpuRegion], overlapping: bool) -> u32 {
+/// Which regions overlap with volume, and need compositing code for it. Regions that
+/// only touch (a dataset and the clip window in its hole, two halves) need none; on
+/// llvmpipe such code costs even where no pixel takes it (a single-region scene ran
+/// 20 % slower with the general code, 10 % with the pair loop).
+///
+/// Without that code a sample inside several regions is the last one's, which is exact
+/// where the others are transparent: so regions `a` before `b` need it only when the
+/// visible part of `a` ([`PreparedRegion::visible_part`]: its occupied bricks) meets
+/// `b` (a window beside a dataset, in the empty part of its box, needs nothing). Parts
+/// meet when their convex parts share volume and a hole of neither holds the common part
+/// (a clip window's region lies in the hole it cuts from the datasets); a common part
+/// that only several holes together cover counts as meeting (the shader then merely has
+/// code it does not need). Pairs that both composite every sample at once (DVR,
+/// gradient-modulated, context-preserving, labels; not segmented) share the DVR loop,
+/// unless a third region meets both; other overlaps are composited sample by sample.
+pub fn overlaps(prepared: &[PreparedRegion]) -> Overlaps {
+    use crate::region::{Plane, Region, has_volume, vertices};
+    let meet = |regions: &[&Region]| -> bool {
+        let all: Vec<Plane> = regions.iter().flat_map(|r| r.planes.iter().copied()).collect();
+        if !has_volume(&all) {
+            return false;
+        }
+        let corners = vertices(&all);
+        let holds = |hole: &[Plane; 6]| corners.iter().all(|p| hole.iter().all(|pl| pl.distance(*p) <= 1e-4 * (1.0 + p.length())));
+        !regions.iter().flat_map(|r| r.holes.iter()).any(holds)
+    };
+    let visible: Vec<_> = prepared.iter().map(|p| p.visible_part()).collect();
+    let dvr_like = |p: &PreparedRegion| p.objects.is_none() && matches!(p.mode, Mode::Dvr | Mode::GradientDvr | Mode::Context);
+    let n = prepared.len();
+    let pairs: Vec<(usize, usize)> =
+        visible.iter().enumerate().flat_map(|(a, va)| (a + 1..n).filter(|&b| meet(&[va, prepared[b].region])).map(move |b| (a, b))).collect();
+    let mut out = Overlaps::default();
+    for &(a, b) in &pairs {
+        let third = (0..n).any(|c| c != a && c != b && meet(&[prepared[a].region, prepared[b].region, prepared[c].region]));
+        if third || !dvr_like(&prepared[a]) || !dvr_like(&prepared[b]) {
+            out.general = true;
+        } else {
+            out.dvr_pairs = true;
+        }
+    }
+    out
+}
+
+/// The shader features a list of regions needs, with their [`overlaps`].
+pub fn scene_features(regions: &[GpuRegion], overlaps: Overlaps) -> u32 {
     use super::gpu_types::features as f;
-    let mut bits = if overlapping { f::MULTI_REGION } else { 0 };
+    let mut bits = if overlaps.general { f::MULTI_REGION } else { 0 };
+    if overlaps.dvr_pairs {
+        bits |= f::DVR_PAIRS;
+    }
     for r in regions {
         let labels = r.flags & region_flags::LABELS != 0;
         bits |= match r.mode {
@@ -345,6 +387,8 @@ pub fn scene_features(regions: &[GpuRegion], overlapping: bool) -> u32 {
 fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &mut PackedScene) -> GpuRegion {
     let plane_offset = out.planes.len() as u32;
     out.planes.extend(p.region.planes.iter().map(|pl| pl.normal.extend(pl.offset)));
+    let hole_offset = out.planes.len() as u32;
+    out.planes.extend(p.region.holes.iter().flatten().map(|pl| pl.normal.extend(pl.offset)));
     let lut_offset = out.lut.len() as u32;
     let mut flags = 0;
     let (lut_a, lut_b, lut_width, labels) = match &p.lookup {
@@ -394,6 +438,8 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
         brick_offset: brick_offset.extend(0),
         plane_offset,
         plane_count: p.region.planes.len() as u32,
+        hole_offset,
+        hole_count: p.region.holes.len() as u32,
         mode: mode_number(p.mode),
         flags,
         lut_offset,
@@ -419,8 +465,22 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
             0.0,
         ),
         sphere: p.sphere.0.extend(p.sphere.1),
+        bounds: polyhedron_sphere(&p.region.planes),
         objects: UVec4::ZERO,
     }
+}
+
+/// A sphere around the convex polyhedron `planes` (the centre of its vertices' bounding
+/// box, the farthest vertex's distance, a little more for rounding); infinite when it
+/// has no vertices.
+pub fn polyhedron_sphere(planes: &[crate::region::Plane]) -> Vec4 {
+    let points = crate::region::vertices(planes);
+    let (Some(lo), Some(hi)) = (points.iter().copied().reduce(glam::Vec3::min), points.iter().copied().reduce(glam::Vec3::max)) else {
+        return Vec4::new(0.0, 0.0, 0.0, f32::MAX);
+    };
+    let center = (lo + hi) * 0.5;
+    let radius = points.iter().map(|p| p.distance(center)).fold(0.0, f32::max);
+    center.extend(radius * (1.0 + 1e-4) + 1e-3)
 }
 
 #[cfg(test)]
@@ -461,12 +521,15 @@ mod tests {
         let fine = region(Mat3::IDENTITY, 32.0, 0.25);
         assert_eq!(march_bound(&[cube, fine], None), 384 + 384 + 8);
         assert_eq!(march_bound(&[], None), 2);
-        // Pieces of one box (a clip window cut it in two): the chords of a ray through
-        // both add up to at most the box's diagonal, 32√3: 192 samples, + 3 per region + 2.
+        // Two halves of one box: the chords of a ray through both add up to at most the
+        // box's diagonal, 32√3: 192 samples, + 3 per region + 2.
         let diagonal = 32.0 * 3f32.sqrt();
         assert_eq!(march_bound(&[cube, cube], Some(diagonal)), 192 + 6 + 2);
         // The extent only ever lowers the bound.
         assert_eq!(march_bound(&[cube], Some(1e6)), 197);
+        // Each hole splits an interval: 3 more.
+        let holed = GpuRegion { hole_count: 2, ..cube };
+        assert_eq!(march_bound(&[holed], None), 197 + 6);
     }
 
     #[test]
@@ -512,10 +575,60 @@ mod tests {
         ];
         let packed = pack(&scene, 2048).unwrap();
         assert_eq!(packed.region_count, 2);
-        assert_eq!(packed.features & features::MULTI_REGION, 0);
-        // The whole volume and one half overlap.
-        scene.regions[0] = whole;
-        assert_ne!(pack(&scene, 2048).unwrap().features & features::MULTI_REGION, 0);
+        assert_eq!(packed.features & (features::MULTI_REGION | features::DVR_PAIRS), 0);
+        // The whole volume and one half overlap: two DVR regions, the pair loop.
+        scene.regions[0] = whole.clone();
+        assert_eq!(pack(&scene, 2048).unwrap().features & (features::MULTI_REGION | features::DVR_PAIRS), features::DVR_PAIRS);
+        // A third region over both, or a MIP region in the pair: sample by sample.
+        let mut three = scene.clone();
+        three.regions.push(whole.clone());
+        assert_ne!(pack(&three, 2048).unwrap().features & features::MULTI_REGION, 0);
+        let mut mixed = scene.clone();
+        mixed.appearances.push(Appearance::new(Mode::Mip, presets::builtin("grayscale_ramp").unwrap()));
+        mixed.regions[1].appearance = 1;
+        assert_ne!(pack(&mixed, 2048).unwrap().features & features::MULTI_REGION, 0);
+        // Unless that half is a hole in the whole (a clip window and its content).
+        let (lo, hi) = v.grid.world_bounds();
+        let half = crate::region::box_planes(&glam::Affine3A::IDENTITY, glam::Vec3::new(centre.x, lo.y - 1.0, lo.z - 1.0), hi + 1.0);
+        scene.regions[0].holes.push(std::array::from_fn(|i| half[i]));
+        let packed = pack(&scene, 2048).unwrap();
+        assert_eq!(packed.features & (features::MULTI_REGION | features::DVR_PAIRS), 0);
+        assert_eq!((packed.regions[0].hole_count, packed.regions[0].hole_offset), (1, 6));
+        // A hole that holds only part of the common part leaves an overlap.
+        let small = crate::region::box_planes(&glam::Affine3A::IDENTITY, centre, hi + 1.0);
+        scene.regions[0].holes[0] = std::array::from_fn(|i| small[i]);
+        assert_ne!(pack(&scene, 2048).unwrap().features & features::DVR_PAIRS, 0);
+    }
+
+    #[test]
+    fn a_region_over_the_empty_part_of_a_box_needs_no_overlap_code() {
+        use super::super::gpu_types::features;
+        // A sphere of radius 6 mm in a 64 mm box at 1 mm: the ramp makes the zeros around
+        // it transparent, so only the bricks at the centre are visible.
+        let v = Arc::new(phantom::sphere(64, 6.0).unwrap());
+        let ramp = presets::builtin("grayscale_ramp").unwrap();
+        let mut scene = RenderScene::single(v.clone(), Appearance::new(Mode::Dvr, ramp.clone()));
+        let corner = |lo: f32, hi: f32| {
+            let planes = crate::region::box_planes(&glam::Affine3A::IDENTITY, glam::Vec3::splat(lo), glam::Vec3::splat(hi));
+            Region { planes, ..Region::volume_box(&v.grid, 0, 1) }
+        };
+        scene.appearances.push(Appearance::new(Mode::Mip, ramp.clone()));
+        // A MIP region in a corner of the box, after the dataset: the dataset is
+        // transparent there, the sample is the window's.
+        scene.regions.push(corner(18.0, 30.0));
+        let bits = |s: &RenderScene| pack(s, 2048).unwrap().features & (features::MULTI_REGION | features::DVR_PAIRS);
+        assert_eq!(bits(&scene), 0);
+        // Over the sphere it needs the general code.
+        scene.regions[1] = corner(-4.0, 4.0);
+        assert_eq!(bits(&scene), features::MULTI_REGION);
+        // Before the dataset in region order, the MIP region would lose its samples to
+        // the dataset's transparent ones: it needs the code too.
+        scene.regions.swap(0, 1);
+        scene.regions[0] = corner(18.0, 30.0);
+        assert_eq!(bits(&scene), features::MULTI_REGION);
+        // Two DVR regions over the sphere: the pair loop.
+        scene.regions = vec![Region::volume_box(&v.grid, 0, 0), Region { appearance: 0, ..corner(-4.0, 4.0) }];
+        assert_eq!(bits(&scene), features::DVR_PAIRS);
     }
 
     #[test]

@@ -44,10 +44,29 @@ const SHADERS: [(Handle<Shader>, &str, &str); 12] = [
     (FEATURE, "shaders/feature.wgsl", include_str!("../../shaders/feature.wgsl")),
 ];
 
-/// Inserts every shader into `Assets<Shader>`.
+/// Environment variable naming a folder (a checkout's root) whose `shaders/` replace the
+/// embedded ones at start-up: shader work without rebuilding the binary.
+pub const SHADERS_FROM: &str = "FOCAL_SHADERS_FROM";
+
+/// Inserts every shader into `Assets<Shader>` (from [`SHADERS_FROM`] when it is set; a
+/// file that cannot be read there keeps the embedded source, with an error in the log).
 pub fn register(app: &mut App) {
+    let from = std::env::var_os(SHADERS_FROM).map(std::path::PathBuf::from);
     let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
-    for (handle, path, source) in SHADERS {
+    for (handle, path, embedded) in SHADERS {
+        let source = match &from {
+            Some(root) => match std::fs::read_to_string(root.join(path)) {
+                Ok(text) => {
+                    warn!("{path}: read from {}", root.display());
+                    std::borrow::Cow::Owned(text)
+                }
+                Err(e) => {
+                    error!("{}: {e}; the embedded {path} is used", root.join(path).display());
+                    std::borrow::Cow::Borrowed(embedded)
+                }
+            },
+            None => std::borrow::Cow::Borrowed(embedded),
+        };
         if let Err(e) = shaders.insert(handle.id(), Shader::from_wgsl(source, path)) {
             error!("cannot register {path}: {e}");
         }

@@ -1,17 +1,13 @@
-//! Oriented boxes (windows and source boxes) and cutting a box out of a convex region.
+//! Oriented boxes: windows and source boxes.
 //!
 //! A box is a centre, a rotation and half extents; its local coordinates run over
 //! `[-1, 1]³`, so the map between two boxes is "same local coordinates"
-//! ([`crate::windows::mapping`]).
-//!
-//! Cutting a box `B` (half-spaces `h₁ … h₆`) out of a convex region `R` leaves a
-//! non-convex set, split here into at most six convex pieces that do not overlap:
-//! `R ∖ B = ⋃ᵢ R ∩ h₁ ∩ … ∩ hᵢ₋₁ ∩ ¬hᵢ`. Pieces that are empty (no vertex) are dropped,
-//! and a region the box does not touch is returned whole.
+//! ([`crate::windows::mapping`]). A clip window's box is cut out of the datasets'
+//! regions as a hole (its six half-spaces, [`OrientedBox::planes`]).
 
 use glam::{Affine3A, Mat3, Quat, Vec3};
 
-use crate::region::{Plane, has_volume};
+use crate::region::Plane;
 
 /// A box in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -71,30 +67,10 @@ impl OrientedBox {
     }
 }
 
-/// Convex pieces of `region ∖ cut` (see the module doc), each a list of planes.
-pub fn subtract(region: &[Plane], cut: &OrientedBox) -> Vec<Vec<Plane>> {
-    let mut with_box = region.to_vec();
-    with_box.extend(cut.planes());
-    if !has_volume(&with_box) {
-        return vec![region.to_vec()];
-    }
-    let mut pieces = Vec::new();
-    let mut inside: Vec<Plane> = region.to_vec();
-    for h in cut.planes() {
-        let mut piece = inside.clone();
-        piece.push(h.flipped());
-        if has_volume(&piece) {
-            pieces.push(piece);
-        }
-        inside.push(h);
-    }
-    pieces
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::region::vertices;
+    use crate::region::{has_volume, vertices};
 
     fn unit_cube() -> Vec<Plane> {
         OrientedBox::aligned(Vec3::splat(-1.0), Vec3::splat(1.0)).planes()
@@ -124,30 +100,38 @@ mod tests {
     }
 
     #[test]
-    fn cutting_a_box_out_leaves_disjoint_pieces_covering_the_rest() {
-        let region = unit_cube();
+    fn a_box_cut_out_as_a_hole() {
+        use crate::region::{Region, ray_convex};
         let cut = OrientedBox { center: Vec3::new(0.2, 0.0, 0.0), rotation: Quat::from_rotation_y(0.3), half: Vec3::splat(0.4) };
-        let pieces = subtract(&region, &cut);
-        assert!(!pieces.is_empty() && pieces.len() <= 6);
-        // Every point of a grid over the region lies in exactly one piece, or in the box.
-        let inside = |planes: &[Plane], p: Vec3| planes.iter().all(|pl| pl.distance(p) < 0.0);
+        let planes = cut.planes();
+        let region = Region {
+            planes: unit_cube(),
+            holes: vec![std::array::from_fn(|i| planes[i])],
+            world_to_voxel: Affine3A::IDENTITY,
+            volume: 0,
+            appearance: 0,
+        };
+        // Every point of a grid over the cube is in the region exactly when it is not
+        // in the box.
         let mut n = 0;
         for i in 0..11 {
             for j in 0..11 {
                 for k in 0..11 {
                     let p = Vec3::new(i as f32, j as f32, k as f32) * 0.19 - 0.95 + Vec3::splat(0.003);
-                    let count = pieces.iter().filter(|pl| inside(pl, p)).count();
                     let in_box = cut.to_local().transform_point3(p).abs().max_element() < 1.0;
-                    assert_eq!(count, usize::from(!in_box), "{p}: {count} pieces, in box {in_box}");
+                    assert_eq!(region.contains(p), !in_box, "{p}");
                     n += usize::from(in_box);
                 }
             }
         }
         assert!(n > 20, "the grid barely met the box: {n}");
-        // A box away from the region leaves it whole.
-        let far = OrientedBox::aligned(Vec3::splat(5.0), Vec3::splat(6.0));
-        assert_eq!(subtract(&region, &far), vec![region.clone()]);
-        // A box around the whole region leaves nothing.
-        assert!(subtract(&region, &OrientedBox::aligned(Vec3::splat(-2.0), Vec3::splat(2.0))).is_empty());
+        // Along any ray the intervals are the cube's chord less the box's.
+        for (o, d) in [(Vec3::new(-3.0, 0.1, 0.05), Vec3::X), (Vec3::new(-2.0, -1.5, 0.2), Vec3::new(1.0, 0.8, -0.1).normalize())] {
+            let total: f32 = region.intersect(o, d).iter().map(|(a, b)| b - a).sum();
+            let (a, b) = ray_convex(&unit_cube(), o, d).unwrap();
+            let hole = ray_convex(&planes, o, d).map_or(0.0, |(c, e)| (e.min(b) - c.max(a)).max(0.0));
+            assert!((total - (b - a - hole)).abs() < 1e-5, "{total} vs {} − {hole}", b - a);
+            assert!(hole > 0.1, "the ray misses the box");
+        }
     }
 }

@@ -9,8 +9,8 @@
 //! *automation* (fit, orientation coupling). In the region model (DESIGN.md) a window
 //! is one region per content: its box, with the map that sends the window onto its
 //! source ([`mapping`]), so it magnifies a smaller source and minifies a larger one
-//! (a world-in-miniature). A clip window cuts its box out of the datasets' regions,
-//! which splits each into convex pieces ([`boxes::subtract`]).
+//! (a world-in-miniature). A clip window cuts its box out of the datasets' regions as a
+//! hole (`region::Region::holes`).
 //!
 //! [`boxes`], [`mapping`], [`regions`], [`interaction`] (focus, dragging, resizing) and
 //! [`markers`] (where markers and the 3D pointer show) are pure; [`systems`] moves

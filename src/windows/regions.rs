@@ -3,19 +3,21 @@
 //! Each content of a window is one region: the window's box, cut to where the content's
 //! data lies, with world → voxel map `V · M` (`V` the dataset's own map, `M` the
 //! window → source map of [`super::mapping`], after the fit automation). A clip window
-//! then cuts its box out of the datasets' own regions (convex pieces,
-//! [`super::boxes::subtract`]); windows never cut each other's contents, so where
-//! windows overlap their contents composite sample by sample, and where clip windows
-//! overlap the datasets are cut by the union of the boxes.
+//! then cuts its box out of the datasets' own regions as a hole ([`Region::holes`]: a
+//! ray meets a dataset in its interval less the box's, so a ray through a window is
+//! three segments: the dataset before the box, the window, the dataset behind it).
+//! Windows never cut each other's contents, so where windows overlap their contents
+//! composite sample by sample, and where clip windows overlap the datasets are cut by
+//! the union of the boxes (each box a hole).
 
 use std::sync::Arc;
 
 use glam::{Affine3A, Vec3};
 
-use super::boxes::{OrientedBox, subtract};
+use super::boxes::OrientedBox;
 use super::components::Fit;
 use super::mapping::{fit, window_to_source};
-use crate::region::{Appearance, Region, RenderScene, box_planes};
+use crate::region::{Appearance, Plane, Region, RenderScene, box_planes, has_volume};
 use crate::volume::Volume;
 
 /// A window placed in the world, its source box turned by any orientation coupling.
@@ -70,24 +72,28 @@ pub fn add_windows(scene: &mut RenderScene, dataset_regions: usize, windows: &[P
             planes.extend(box_planes(&to_voxel, Vec3::splat(-0.5), c.volume.dims().as_vec3() - 0.5));
             scene.regions.push(Region {
                 planes,
+                holes: Vec::new(),
                 world_to_voxel: to_voxel,
                 volume: c.volume_index,
                 appearance: scene.appearances.len() - 1,
             });
         }
     }
-    let clips: Vec<&OrientedBox> = windows.iter().filter(|w| w.clip).map(|w| &w.window).collect();
-    if clips.is_empty() {
-        return;
-    }
     let n = dataset_regions.min(scene.regions.len());
-    let mut cut = Vec::with_capacity(n);
-    for r in scene.regions.drain(..n) {
-        let mut pieces = vec![r.planes.clone()];
-        for b in &clips {
-            pieces = pieces.iter().flat_map(|p| subtract(p, b)).collect();
+    for b in windows.iter().filter(|w| w.clip).map(|w| &w.window) {
+        for r in &mut scene.regions[..n] {
+            if touches(&r.planes, b) {
+                let planes = b.planes();
+                r.holes.push(std::array::from_fn(|i| planes[i]));
+            }
         }
-        cut.extend(pieces.into_iter().map(|planes| Region { planes, ..r.clone() }));
     }
-    scene.regions.splice(0..0, cut);
+}
+
+/// Whether the box meets the convex region `planes` with volume (a box that does not
+/// leaves the region as it is).
+fn touches(planes: &[Plane], b: &OrientedBox) -> bool {
+    let mut both = planes.to_vec();
+    both.extend(b.planes());
+    has_volume(&both)
 }

@@ -11,16 +11,18 @@
 //! `--context` (context-preserving rendering against DVR on the engine: at κt = 0, the
 //! same picture, the cost of evaluating equation 5; goal: at most 5 %), `--twolevel`
 //! (two-level rendering of the head CT split by its labels against no objects),
-//! `--windows` (one clip window and four windows against none; goals ≤ ×1.10 and
-//! ≤ ×1.33). Each line
-//! ends with the ratio against its group's baseline; `--json` prints the same as JSON.
+//! `--windows` (volumetric windows against none, [`windows`]: one and four clip windows
+//! showing the dataset as it is, goals ≤ ×1.10 and ≤ ×1.33; the cutaway, the windows of
+//! the paper's figures 3–6, a window over the head without clip, two halves). Each line
+//! ends with the ratio against its group's baseline; `--json` prints the same as JSON,
+//! `--save DIR` writes each configuration's picture, and `FOCAL_BENCH_SAMPLES=1` prints
+//! every timed frame (frame times on llvmpipe scatter by ±15 %: time enough frames).
 
 use std::sync::Arc;
 
 use bevy::prelude::*;
 use clap::Args;
 use focal::FocalPlugins;
-use focal::clip::{ClipPlane, Clipping};
 use focal::context::{ContextParams, Power};
 use focal::dataset::Dataset;
 use focal::lens::systems::replace_lenses;
@@ -32,8 +34,9 @@ use focal::transfer::{LabelTransfer, presets};
 use focal::twolevel::{Object, Segmentation};
 use focal::volume::Volume;
 use focal::volume::phantom::{self, Phantom};
-use focal::windows::{Content, Source, SourceBox, VolumeWindow};
 use serde_json::json;
+
+mod windows;
 
 #[derive(Args)]
 pub struct BenchArgs {
@@ -70,6 +73,10 @@ pub struct BenchArgs {
     /// Print JSON.
     #[arg(long)]
     json: bool,
+    /// Save the picture of every configuration timed in rounds into this folder
+    /// (`GROUP-N.png`, N in the order of the group's lines).
+    #[arg(long, value_name = "DIR")]
+    save: Option<std::path::PathBuf>,
 }
 
 struct Row {
@@ -84,6 +91,7 @@ struct Row {
 struct Bench {
     off: Offscreen,
     frames: u32,
+    save: Option<std::path::PathBuf>,
 }
 
 impl Bench {
@@ -189,6 +197,11 @@ impl Bench {
                 samples.push(t.as_secs_f64() * 1000.0);
             }
         }
+        if std::env::var_os("FOCAL_BENCH_SAMPLES").is_some() {
+            for (i, v) in times.iter().enumerate() {
+                eprintln!("config {i}: {}", v.iter().map(|t| format!("{t:.0}")).collect::<Vec<_>>().join(" "));
+            }
+        }
         let medians = times
             .into_iter()
             .map(|mut v| {
@@ -200,13 +213,22 @@ impl Bench {
     }
 }
 
-/// The second half of the head in the windows group's two-region configuration.
-#[derive(Component)]
-struct BenchHalf;
-
 /// Names of configurations.
 fn names(configs: &[Config]) -> Vec<&'static str> {
     configs.iter().map(|c| c.0).collect()
+}
+
+impl Bench {
+    /// Writes a group's pictures when `--save` asked for them.
+    fn save_images(&self, group: &str, images: &[image::RgbaImage]) -> Result<(), String> {
+        let Some(dir) = &self.save else { return Ok(()) };
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        for (i, im) in images.iter().enumerate() {
+            let path = dir.join(format!("{group}-{i}.png"));
+            im.save(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        Ok(())
+    }
 }
 
 /// Rows of a group timed by [`Bench::interleaved`], against its first configuration.
@@ -234,7 +256,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         app.add_plugins(FocalPlugins);
     })?;
     eprintln!("GPU: {}  image {w}×{h}, {} frames per configuration", off.adapter_name(), args.frames);
-    let mut bench = Bench { off, frames: args.frames.max(1) };
+    let mut bench = Bench { off, frames: args.frames.max(1), save: args.save.clone() };
     let still = VolumeView { jitter: false, ..Default::default() };
     let mut rows = Vec::new();
 
@@ -250,12 +272,14 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let (ms, images) = bench.interleaved(Arc::new(head.labels.volume), a, &configs, false)?;
         let note = format!("image differs by at most {} levels", difference(&images[0], &images[1]));
         push_group(&mut rows, "skipping", &names(&configs), &ms, "head phantom arteries (label volume)", &note);
+        bench.save_images("skipping", &images)?;
     }
     if all || args.termination {
         let ct = Arc::new(Phantom::Head.generate(args.resolution)?);
         let a = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone")?);
         let configs = [("termination on", vec![], still), ("termination off", vec![], VolumeView { early_termination: false, ..still })];
-        let (ms, _) = bench.interleaved(ct, a, &configs, false)?;
+        let (ms, images) = bench.interleaved(ct, a, &configs, false)?;
+        bench.save_images("termination", &images)?;
         push_group(&mut rows, "termination", &names(&configs), &ms, "head phantom, CT skin + bone", "");
     }
     if all || args.modes {
@@ -303,6 +327,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let (ms, images) = bench.interleaved_appearances(engine, &appearances, still)?;
         let note = format!("κt 0 differs from DVR by at most {} levels; goal ≤ ×1.05", difference(&images[0], &images[1]));
         push_group(&mut rows, "context", &names, &ms, "engine phantom", &note);
+        bench.save_images("context", &images)?;
     }
 
     if all || args.twolevel {
@@ -338,61 +363,11 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let (ms, images) = bench.interleaved_appearances(ct, &appearances, still)?;
         let note = format!("objects alike differ from no objects by at most {} levels", difference(&images[0], &images[1]));
         push_group(&mut rows, "twolevel", &names, &ms, "head phantom", &note);
+        bench.save_images("twolevel", &images)?;
     }
 
     if all || args.windows {
-        // Volumetric windows on the head CT (the head as two clipped halves, two regions
-        // and the same picture, measures the multi-region shader alone): none, one clip window showing the dataset as
-        // it is (the same picture: the cost of the window's regions alone), one showing
-        // bone (a cutaway: the rays also go deeper), four windows (the clip window and three ×2 windows of
-        // source boxes inside the head). Goals: one clip window ≤ ×1.10 (≥ 90 % of the
-        // frame rate), four ≤ ×1.33 (≥ 75 %).
-        let ct = Arc::new(Phantom::Head.generate(args.resolution)?);
-        let skin = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone")?);
-        let bone = Appearance::new(Mode::Dvr, presets::builtin("ct_bone")?);
-        let names = ["no window", "one clip window, same look", "one clip window, bone", "four windows", "no window, two halves"];
-        let same = skin.clone();
-        let half = |flip: bool| Clipping { planes: vec![ClipPlane { flip, ..ClipPlane::new(Vec3::ZERO, Vec3::X) }], clip_box: None };
-        let (ms, images) = bench.interleaved_by(ct.clone(), skin.clone(), 5, false, |off, i| {
-            let world = off.world_mut();
-            let old: Vec<Entity> =
-                world.query_filtered::<Entity, Or<(With<VolumeWindow>, With<SourceBox>, With<BenchHalf>)>>().iter(world).collect();
-            for e in old {
-                world.despawn(e);
-            }
-            let Some(data) = world.query_filtered::<Entity, With<Dataset>>().iter(world).next() else { return };
-            // The last configuration: the head as two datasets, each clipped to one half
-            // (the same picture from two regions: the multi-region shader alone).
-            if let Some(mut d) = world.get_mut::<Dataset>(data) {
-                d.clip = if i == 4 { half(false) } else { Clipping::default() };
-            }
-            if i == 4 {
-                let mut other = Dataset::new(ct.clone(), skin.clone());
-                other.clip = half(true);
-                world.spawn((other, Transform::default(), BenchHalf));
-                return;
-            }
-            let look = if i == 1 { same.clone() } else { bone.clone() };
-            let content = vec![Content { dataset: data, appearance: Some(look) }];
-            if i >= 1 {
-                let cut = VolumeWindow { clip: true, ..VolumeWindow::new(Vec3::new(80.0, 80.0, 80.0), content.clone()) };
-                world.spawn((cut, Transform::from_xyz(40.0, -40.0, 40.0)));
-            }
-            if i >= 3 {
-                for k in 0..3 {
-                    let x = -80.0 + 60.0 * k as f32;
-                    let source = world.spawn((SourceBox { size: Vec3::splat(20.0) }, Transform::from_xyz(x * 0.3, 0.0, 0.0))).id();
-                    let w = VolumeWindow { source: Source::Box(source), ..VolumeWindow::new(Vec3::splat(40.0), content.clone()) };
-                    world.spawn((w, Transform::from_xyz(x, -60.0, -70.0)));
-                }
-            }
-        })?;
-        let note = format!(
-            "same look and two halves differ from no window by at most {} and {} levels; goals: one clip window ≤ ×1.10, four ≤ ×1.33",
-            difference(&images[0], &images[1]),
-            difference(&images[0], &images[4])
-        );
-        push_group(&mut rows, "windows", &names, &ms, "head phantom", &note);
+        windows::group(&mut bench, &mut rows, args.resolution)?;
     }
 
     if all || args.lenses {
@@ -423,7 +398,8 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             ("angular + AA", vec![fisheye], aa(true)),
             ("4 lenses + AA", four, aa(true)),
         ];
-        let (ms, _) = bench.interleaved(ct, a, &configs, false)?;
+        let (ms, images) = bench.interleaved(ct, a, &configs, false)?;
+        bench.save_images("lenses", &images)?;
         push_group(&mut rows, "lenses", &names(&configs), &ms, "head phantom, CT skin + bone", "goal ≤ ×1.10");
 
         // The feature lens needs its silhouette again whenever the camera moves: timed
@@ -438,7 +414,8 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             ("feature (GPU)", vec![feature.clone()], VolumeView { gpu_silhouettes: true, ..still }),
             ("feature (CPU)", vec![feature], VolumeView { gpu_silhouettes: false, ..still }),
         ];
-        let (ms, _) = bench.interleaved(Arc::new(head.labels.volume), labels, &configs, true)?;
+        let (ms, images) = bench.interleaved(Arc::new(head.labels.volume), labels, &configs, true)?;
+        bench.save_images("feature-lens", &images)?;
         push_group(&mut rows, "lenses", &names(&configs), &ms, "labelled head phantom", "silhouette every frame; goal ≤ ×1.25");
         replace_lenses(bench.off.world_mut(), &[]);
     }
