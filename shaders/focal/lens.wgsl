@@ -354,7 +354,9 @@ fn restrict_footprint(t0: f32, t1: f32) {
 
 // Sets the mip level of the samples at ray parameter t.
 fn update_lod(t: f32) {
+#ifdef LENS_ANTIALIAS
     if has_footprint {
         set_lod(lod_at(t));
     }
+#endif
 }

@@ -28,37 +28,37 @@ fn trilinear_box(offset: vec3<f32>, dims: vec3<f32>, q: vec3<f32>) -> f32 {
     return textureSampleLevel(volume_atlas, volume_sampler, (offset + c + 0.5) * scene.inv_atlas_size.xyz, 0.0).r;
 }
 
-// Sample of mip level k (volume::pyramid: index (q + ½)/2^k − ½, size ⌈dims/2^k⌉).
+// Sample of mip level k (volume::pyramid: index (q + ½)/2^k − ½, size ⌈dims/2^k⌉; level
+// 0 is the volume itself): the level's box is chosen by selects and fetched once.
 fn level_sample(r: Region, q: vec3<f32>, k: u32) -> f32 {
-    if k == 0u {
-        return trilinear_box(r.atlas_offset.xyz, r.dims.xyz, q);
-    }
-    var offset = r.mips[0].xyz;
-    if k == 2u {
+    var offset = r.atlas_offset.xyz;
+    if k == 1u {
+        offset = r.mips[0].xyz;
+    } else if k == 2u {
         offset = r.mips[1].xyz;
-    } else if k == 3u {
+    } else if k >= 3u {
         offset = r.mips[2].xyz;
     }
-    let s = exp2(f32(k));
+    let s = exp2(f32(min(k, 3u)));
     return trilinear_box(offset, ceil(r.dims.xyz / s), (q + 0.5) / s - 0.5);
 }
 
 // Trilinear sample (normalised) at continuous voxel index q, clamped to the edge voxels;
 // under lenses from the current mip level (two levels blended).
 fn trilinear(r: Region, q: vec3<f32>) -> f32 {
-#ifdef HAS_LENSES
-    if sample_lod > 0.0 && r.mip_count > 0u {
-        let l = min(sample_lod, f32(r.mip_count));
-        let k = u32(floor(l));
-        let f = l - f32(k);
-        let a = level_sample(r, q, k);
-        if f > 0.0 {
-            return mix(a, level_sample(r, q, k + 1u), f);
-        }
-        return a;
-    }
-#endif
+#ifdef LENS_ANTIALIAS
+    // (A shader def, not the view's flag: llvmpipe runs an `if` in every lane whatever
+    // the condition, and this code made every sample under a lens three times as
+    // expensive without anti-aliasing. With it, two fetches per sample, the levels on
+    // either side of the sample's, at full resolution the volume twice.)
+    let l = clamp(sample_lod, 0.0, f32(r.mip_count));
+    let k = u32(floor(l));
+    let a = level_sample(r, q, k);
+    let b = level_sample(r, q, min(k + 1u, r.mip_count));
+    return mix(a, b, l - f32(k));
+#else
     return trilinear_box(r.atlas_offset.xyz, r.dims.xyz, q);
+#endif
 }
 
 // Code of the voxel nearest to q (label volumes).

@@ -57,9 +57,11 @@ pub mod features {
     pub const TWO_LEVEL: u32 = 512;
     /// Two DVR-like regions overlap: the DVR loop takes both at each sample.
     pub const DVR_PAIRS: u32 = 1024;
+    /// The view has lenses with anti-aliasing (a per-view feature, with [`LENSES`]).
+    pub const LENS_ANTIALIAS: u32 = 2048;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 11] = [
+    pub const NAMES: [(u32, &str); 12] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -71,6 +73,7 @@ pub mod features {
         (CONTEXT, "HAS_CONTEXT"),
         (TWO_LEVEL, "HAS_TWO_LEVEL"),
         (DVR_PAIRS, "DVR_PAIRS"),
+        (LENS_ANTIALIAS, "LENS_ANTIALIAS"),
     ];
 }
 

@@ -99,7 +99,11 @@ pub fn prepare_pipelines(
     views: Query<(Entity, &ViewTarget, &GpuSettings), With<ExtractedView>>,
 ) {
     for (entity, target, settings) in &views {
-        let lenses = if settings.lens_count > 0 { features::LENSES } else { 0 };
+        let lenses = match (settings.lens_count > 0, settings.flags & super::gpu_types::view_flags::LENS_ANTIALIAS != 0) {
+            (false, _) => 0,
+            (true, false) => features::LENSES,
+            (true, true) => features::LENSES | features::LENS_ANTIALIAS,
+        };
         let key = RaycastKey { format: target.main_texture_format(), features: scene.features | lenses };
         let id = pipelines.specialize(&cache, &pipeline, key);
         commands.entity(entity).insert(RaycastPipelineId(id));
