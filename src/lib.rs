@@ -2,7 +2,7 @@
 //!
 //! The crate is organised by technique (see `../shared/DESIGN.md` and the README):
 //! [`volume`] holds the data model, readers and phantoms; [`transfer`] the transfer
-//! functions; [`region`] the geometry every renderer shares; [`lens`] the magic volume lenses; [`context`] context-preserving rendering; [`clip`] clip planes and boxes; [`twolevel`] two-level rendering of segmented data; [`windows`] volumetric windows; [`reference`] the CPU
+//! functions; [`region`] the geometry every renderer shares; [`lens`] the magic volume lenses; [`context`] context-preserving rendering; [`clip`] clip planes and boxes; [`twolevel`] two-level rendering of segmented data; [`windows`] volumetric windows; [`explode`] exploded views; [`reference`] the CPU
 //! reference renderer; [`dataset`] the dataset entities that become regions; [`render`]
 //! the GPU ray caster that packs and draws them; [`scene`] scene files; [`ui`] the
 //! desktop app.
@@ -10,6 +10,7 @@
 pub mod clip;
 pub mod context;
 pub mod dataset;
+pub mod explode;
 pub mod lens;
 pub mod reference;
 pub mod region;

@@ -1,0 +1,214 @@
+//! Convex parts of an exploded dataset and splitting them (Bruckner and Gröller 2006,
+//! section 3.1).
+//!
+//! The background (everything not selected) starts as one part, the dataset's box, and
+//! is cut into convex parts by planes. A part is a convex polyhedron given by half-spaces
+//! in the dataset's own frame (so it moves with the dataset), with its vertices for the
+//! forces (the return force acts at them) and the collider (their convex hull). Splitting
+//! a part by a plane gives the two halves `P ∩ {n·p ≤ d}` and `P ∩ {n·p ≥ d}`: they
+//! partition it, and a plane that misses the part (one half without volume) leaves it
+//! whole.
+
+use glam::Vec3;
+
+use crate::region::{Plane, bounding_planes, has_volume, vertices};
+
+/// A convex polyhedron in a dataset's own frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Polyhedron {
+    /// Half-spaces (normals out), only those that bound it.
+    pub planes: Vec<Plane>,
+    /// Its vertices.
+    pub vertices: Vec<Vec3>,
+}
+
+impl Polyhedron {
+    /// The polyhedron of `planes`, or `None` when it has no volume.
+    pub fn new(planes: &[Plane]) -> Option<Polyhedron> {
+        if !has_volume(planes) {
+            return None;
+        }
+        let planes = bounding_planes(planes);
+        let vertices = dedup(vertices(&planes));
+        Some(Polyhedron { planes, vertices })
+    }
+
+    /// The axis-aligned box `[lo, hi]`.
+    pub fn cuboid(lo: Vec3, hi: Vec3) -> Polyhedron {
+        let planes: Vec<Plane> =
+            (0..3).flat_map(|a| [Plane { normal: Vec3::AXES[a], offset: hi[a] }, Plane { normal: -Vec3::AXES[a], offset: -lo[a] }]).collect();
+        let vertices = (0..8)
+            .map(|c: usize| Vec3::new(if c & 1 == 0 { lo.x } else { hi.x }, if c & 2 == 0 { lo.y } else { hi.y }, if c & 4 == 0 { lo.z } else { hi.z }))
+            .collect();
+        Polyhedron { planes, vertices }
+    }
+
+    /// The two halves on either side of `plane` (the one `plane` keeps first), or `None`
+    /// when the plane does not cut the part with volume on both sides.
+    pub fn split(&self, plane: Plane) -> Option<(Polyhedron, Polyhedron)> {
+        let scale = self.vertices.iter().map(|v| v.length()).fold(1.0, f32::max);
+        let side = |v: &Vec3| plane.distance(*v) / scale;
+        // Quick rejection: all vertices (nearly) on one side.
+        if self.vertices.iter().all(|v| side(v) > -1e-5) || self.vertices.iter().all(|v| side(v) < 1e-5) {
+            return None;
+        }
+        let with = |p: Plane| {
+            let mut planes = self.planes.clone();
+            planes.push(p);
+            Polyhedron::new(&planes)
+        };
+        Some((with(plane)?, with(plane.flipped())?))
+    }
+
+    /// The centroid of the solid (tetrahedra from the vertex mean to each face).
+    pub fn centroid(&self) -> Vec3 {
+        let (volume, moment) = self.faces().iter().fold((0.0f64, glam::DVec3::ZERO), |(v, m), face| {
+            let apex = self.vertex_mean().as_dvec3();
+            let (a, fan) = (face[0].as_dvec3(), &face[1..]);
+            fan.windows(2).fold((v, m), |(v, m), e| {
+                let (b, c) = (e[0].as_dvec3(), e[1].as_dvec3());
+                let vol = (a - apex).dot((b - apex).cross(c - apex)).abs() / 6.0;
+                (v + vol, m + (apex + a + b + c) * 0.25 * vol)
+            })
+        });
+        if volume <= 0.0 { self.vertex_mean() } else { (moment / volume).as_vec3() }
+    }
+
+    /// The volume of the solid.
+    pub fn volume(&self) -> f32 {
+        let apex = self.vertex_mean().as_dvec3();
+        self.faces()
+            .iter()
+            .map(|face| {
+                let a = face[0].as_dvec3();
+                face[1..].windows(2).map(|e| (a - apex).dot((e[0].as_dvec3() - apex).cross(e[1].as_dvec3() - apex)).abs() / 6.0).sum::<f64>()
+            })
+            .sum::<f64>() as f32
+    }
+
+    /// The mean of the vertices.
+    pub fn vertex_mean(&self) -> Vec3 {
+        self.vertices.iter().copied().sum::<Vec3>() / self.vertices.len().max(1) as f32
+    }
+
+    /// Each face's vertices in order around it.
+    pub fn faces(&self) -> Vec<Vec<Vec3>> {
+        let scale = self.vertices.iter().map(|v| v.length()).fold(1.0, f32::max);
+        self.planes
+            .iter()
+            .filter_map(|pl| {
+                let on: Vec<Vec3> = self.vertices.iter().copied().filter(|v| pl.distance(*v).abs() <= 1e-4 * scale).collect();
+                if on.len() < 3 {
+                    return None;
+                }
+                let c = on.iter().copied().sum::<Vec3>() / on.len() as f32;
+                let u = (on[0] - c).normalize_or_zero();
+                let w = pl.normal.cross(u);
+                let mut sorted = on;
+                sorted.sort_by(|a, b| (*a - c).dot(w).atan2((*a - c).dot(u)).total_cmp(&(*b - c).dot(w).atan2((*b - c).dot(u))));
+                Some(sorted)
+            })
+            .collect()
+    }
+
+    /// Whether a point lies inside (boundary included).
+    pub fn contains(&self, p: Vec3) -> bool {
+        self.planes.iter().all(|pl| pl.distance(p) <= 1e-4)
+    }
+
+    /// The point of the polyhedron closest to `p` (`p` itself inside), by projecting onto
+    /// the faces, edges and vertices.
+    pub fn closest_point(&self, p: Vec3) -> Vec3 {
+        if self.contains(p) {
+            return p;
+        }
+        let mut best = self.vertices.first().copied().unwrap_or(p);
+        let mut consider = |q: Vec3| {
+            if q.distance_squared(p) < best.distance_squared(p) {
+                best = q;
+            }
+        };
+        for face in self.faces() {
+            let n = (face[1] - face[0]).cross(face[2] - face[0]).normalize_or_zero();
+            let q = p - n * (p - face[0]).dot(n);
+            if self.contains(q) {
+                consider(q);
+            }
+            for (i, a) in face.iter().enumerate() {
+                let b = face[(i + 1) % face.len()];
+                let ab = b - *a;
+                let s = ((p - *a).dot(ab) / ab.length_squared().max(1e-20)).clamp(0.0, 1.0);
+                consider(*a + ab * s);
+            }
+        }
+        best
+    }
+}
+
+/// Vertices without the near-duplicates where more than three planes meet.
+fn dedup(points: Vec<Vec3>) -> Vec<Vec3> {
+    let scale = points.iter().map(|v| v.length()).fold(1.0, f32::max);
+    let mut out: Vec<Vec3> = Vec::with_capacity(points.len());
+    for p in points {
+        if !out.iter().any(|q| q.distance(p) <= 1e-4 * scale) {
+            out.push(p);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_split_partitions_the_part() {
+        let cube = Polyhedron::cuboid(Vec3::ZERO, Vec3::splat(2.0));
+        assert_eq!((cube.vertices.len(), cube.planes.len()), (8, 6));
+        assert!((cube.volume() - 8.0).abs() < 1e-4 && (cube.centroid() - Vec3::ONE).length() < 1e-5);
+        // An oblique plane through (1, 1, 1): the halves' volumes add up to the cube's,
+        // each point of a lattice lies in exactly one (off the plane), and the plane is
+        // a face of both.
+        let plane = Plane::through(Vec3::ONE, Vec3::new(1.0, 0.5, 0.25));
+        let (a, b) = cube.split(plane).unwrap();
+        assert!((a.volume() + b.volume() - 8.0).abs() < 1e-3, "{} + {}", a.volume(), b.volume());
+        // Through the centre of a centrally symmetric solid: equal halves.
+        assert!((a.volume() - 4.0).abs() < 1e-3);
+        for i in 0..10 {
+            for j in 0..10 {
+                for k in 0..10 {
+                    let p = Vec3::new(i as f32, j as f32, k as f32) * 0.2 + 0.1 + 0.003;
+                    if plane.distance(p).abs() < 1e-3 {
+                        continue;
+                    }
+                    assert_eq!(a.contains(p) as u8 + b.contains(p) as u8, 1, "{p}");
+                    assert_eq!(a.contains(p), plane.distance(p) < 0.0);
+                }
+            }
+        }
+        for half in [&a, &b] {
+            let on = half.vertices.iter().filter(|v| plane.distance(**v).abs() < 1e-4).count();
+            assert!(on >= 3, "the cut is a face");
+        }
+        // A plane beside the cube, or touching a face, cuts nothing.
+        assert!(cube.split(Plane::through(Vec3::splat(3.0), Vec3::X)).is_none());
+        assert!(cube.split(Plane::through(Vec3::ZERO, Vec3::X)).is_none());
+    }
+
+    #[test]
+    fn faces_centroids_and_closest_points() {
+        // A wedge: the unit cube cut by x + y ≤ 1 (a triangular prism of volume ½, its
+        // centroid at (⅓, ⅓, ½)).
+        let (wedge, _) = Polyhedron::cuboid(Vec3::ZERO, Vec3::ONE).split(Plane::through(Vec3::new(0.5, 0.5, 0.0), Vec3::new(1.0, 1.0, 0.0))).unwrap();
+        assert_eq!(wedge.vertices.len(), 6);
+        assert_eq!(wedge.faces().len(), 5);
+        assert!((wedge.volume() - 0.5).abs() < 1e-5);
+        assert!((wedge.centroid() - Vec3::new(1.0 / 3.0, 1.0 / 3.0, 0.5)).length() < 1e-5, "{}", wedge.centroid());
+        // Closest points: inside itself; beyond the slanted face its foot; beyond an
+        // edge and a corner, those.
+        assert_eq!(wedge.closest_point(Vec3::splat(0.2)), Vec3::splat(0.2));
+        assert!((wedge.closest_point(Vec3::new(1.0, 1.0, 0.5)) - Vec3::new(0.5, 0.5, 0.5)).length() < 1e-5);
+        assert!((wedge.closest_point(Vec3::new(-1.0, -1.0, 0.5)) - Vec3::new(0.0, 0.0, 0.5)).length() < 1e-5);
+        assert!((wedge.closest_point(Vec3::new(-1.0, -1.0, 2.0)) - Vec3::new(0.0, 0.0, 1.0)).length() < 1e-5);
+    }
+}
