@@ -2,8 +2,9 @@
 //! 1–5), as pure functions: each returns a force and the point it acts at, and
 //! [`Wrench::about`] turns a sum of them into the force and torque a rigid body takes.
 //!
-//! Distances are measured in units of a length `ℓ` ([`Scale::length`], a tenth of the
-//! dataset's diagonal by default): the paper's formulas are written in such normalised
+//! Distances are measured in units of a length `ℓ` ([`Scale::length`], a quarter of the
+//! dataset's diagonal by default: a degree of 1 then pushes parts about a sixth of the
+//! diagonal out, 3 about a third): the paper's formulas are written in such normalised
 //! units, and in millimetres `e^‖r‖` would vanish a few millimetres from a point. Forces
 //! come out in units of [`Scale::force`]. With `r' = r/ℓ`:
 //!
@@ -12,7 +13,11 @@
 //!   original position, each divided by the part's vertex count and applied at the
 //!   vertex (so it also turns parts back). The paper writes `ln ‖r‖`, which is negative
 //!   below one unit and would push a part off its place; `ln(1 + ‖r'‖)` is 0 at rest and
-//!   grows as slowly.
+//!   grows as slowly. Near half a turn the vertex springs' torque vanishes (a part
+//!   flipped by the explosion crept back over minutes), so a torque towards the rest
+//!   orientation joins them: `τ = −c_r · ρ · θ · â` for a turn by `θ` about `â`, `ρ` the
+//!   part's radius (in force units × millimetres), as strong as the springs for small
+//!   turns.
 //! - **Explosion** (eq. 2): each explosion point `p` pushes every part at the part's
 //!   point `x` closest to it, `F_e = c_e / e^‖r'‖ · r̂`, `r = x − p`; the points carry
 //!   weights (their octree node's size) and the sum is divided by the weights' total.
@@ -105,6 +110,18 @@ pub fn return_force(current: Vec3, original: Vec3, c_r: f32, scale: Scale) -> Ve
     r.normalize() * c_r * (1.0 + d).ln() * scale.force
 }
 
+/// The torque turning a part back to its rest orientation from `rotation` (see the
+/// module doc); `radius` is the part's farthest vertex from its centre.
+pub fn return_torque(rotation: glam::Quat, radius: f32, c_r: f32, scale: Scale) -> Vec3 {
+    let (axis, angle) = rotation.to_axis_angle();
+    // The shorter way round.
+    let angle = if angle > std::f32::consts::PI { angle - std::f32::consts::TAU } else { angle };
+    if !angle.is_finite() || angle == 0.0 {
+        return Vec3::ZERO;
+    }
+    -axis * angle * c_r * radius / scale.length * scale.force * radius
+}
+
 /// Equation 2: explosion point `point` on a part whose closest point to it is `closest`.
 pub fn explosion_force(point: Vec3, closest: Vec3, c_e: f32, scale: Scale) -> Vec3 {
     let r = closest - point;
@@ -186,13 +203,17 @@ pub fn part_wrench(part: &PartNow, around: &Surroundings, c: &Coefficients, scal
     let mut pushes: Vec<Push> = returns.collect();
     let total: f32 = around.points.iter().map(|p| p.weight).sum();
     if total > 0.0 && c.degree != 0.0 {
-        let world = moved(part.rest, part.to_world);
-        let center = part.to_world.transform_point3(part.rest.centroid());
+        // Closest points in the part's rest frame (the motion is rigid: distances keep).
+        let (m, back) = (part.to_world, part.to_world.inverse());
+        let rest_center = part.rest.centroid();
+        let center = m.transform_point3(rest_center);
         for p in around.points {
-            let x = world.closest_point(p.position);
+            let x = m.transform_point3(part.rest.closest_point(back.transform_point3(p.position)));
             pushes.push(Push { force: explosion_force(p.position, x, c.explosion(), scale) * (p.weight / total), at: x });
             if let Some(eye) = around.eye {
-                let (dir, d, at) = off_ray(eye, p.position - eye, &world, center, scale);
+                let (eye_rest, dir_rest) = (back.transform_point3(eye), back.transform_vector3(p.position - eye));
+                let (dir, d, at) = off_ray(eye_rest, dir_rest, part.rest, rest_center, scale);
+                let (dir, at) = (m.transform_vector3(dir), m.transform_point3(at));
                 pushes.push(Push { force: viewing_force(dir, d, c.viewing(), scale) * (p.weight / total), at });
             }
         }
@@ -203,16 +224,12 @@ pub fn part_wrench(part: &PartNow, around: &Surroundings, c: &Coefficients, scal
             }
         }
     }
-    Wrench::about(part.center_of_mass, pushes)
-}
-
-/// The polyhedron placed by a rigid motion.
-pub fn moved(p: &Polyhedron, to_world: glam::Affine3A) -> Polyhedron {
-    let inverse = to_world.inverse();
-    Polyhedron {
-        planes: p.planes.iter().map(|pl| super::splitters::in_part_frame(*pl, inverse)).collect(),
-        vertices: p.vertices.iter().map(|v| to_world.transform_point3(*v)).collect(),
-    }
+    let mut w = Wrench::about(part.center_of_mass, pushes);
+    let (_, rotation, _) = part.to_world.to_scale_rotation_translation();
+    let rest_center = part.rest.centroid();
+    let radius = part.rest.vertices.iter().map(|v| v.distance(rest_center)).fold(0.0, f32::max);
+    w.torque += return_torque(rotation, radius, c.returning, scale);
+    w
 }
 
 #[cfg(test)]
@@ -239,6 +256,13 @@ mod tests {
         // Spacing: centres 2ℓ apart, c_s = 1/6: (1/6)/4·10 away from the other.
         let f = spacing_force(Vec3::new(0.0, 4.0, 0.0), Vec3::ZERO, 1.0 / 6.0, UNIT);
         assert!((f - Vec3::Y * (10.0 / 24.0)).length() < 1e-5, "{f}");
+        // The turning-back torque: a quarter turn about z, radius 4 mm = 2ℓ, c_r = 1:
+        // −(π/2)·1·(4/2)·10·4 about z.
+        let t = return_torque(glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2), 4.0, 1.0, UNIT);
+        assert!((t - Vec3::NEG_Z * std::f32::consts::FRAC_PI_2 * 80.0).length() < 1e-3, "{t}");
+        // Three quarters of a turn is a quarter back the other way.
+        let t = return_torque(glam::Quat::from_rotation_z(1.5 * std::f32::consts::PI), 4.0, 1.0, UNIT);
+        assert!((t - Vec3::Z * std::f32::consts::FRAC_PI_2 * 80.0).length() < 1e-2, "{t}");
         // Equation 5.
         let c = Coefficients { degree: 3.0, ..Default::default() };
         assert_eq!((c.explosion(), c.viewing(), c.spacing()), (1.5, 1.0, 0.5));

@@ -8,8 +8,20 @@
 //! - [`forces`]: the return, explosion, viewing and spacing forces (section 3.2,
 //!   equations 1–5).
 //!
-//! All three are pure (glam only) and unit-tested against values worked out by hand.
+//! - [`points`]: explosion points from the data's and the selection's min-max octrees;
+//! - [`regions`]: parts as regions of the ray caster;
+//! - [`components`], [`systems`]: parts as rapier rigid bodies, the forces of each step.
+//!
+//! The math modules are pure (glam only) and unit-tested against values worked out by
+//! hand.
 
+pub mod components;
 pub mod forces;
 pub mod parts;
+pub mod points;
+pub mod regions;
 pub mod splitters;
+pub mod systems;
+
+pub use components::{ExplodeTiming, Exploded, ExplosionPoints, Part};
+pub use systems::{ExplodePlugin, ExplodeStep, step};

@@ -20,6 +20,8 @@ pub struct Polyhedron {
     pub planes: Vec<Plane>,
     /// Its vertices.
     pub vertices: Vec<Vec3>,
+    /// Each face's vertices in order around it (one face per plane).
+    pub faces: Vec<Vec<Vec3>>,
 }
 
 impl Polyhedron {
@@ -30,17 +32,19 @@ impl Polyhedron {
         }
         let planes = bounding_planes(planes);
         let vertices = dedup(vertices(&planes));
-        Some(Polyhedron { planes, vertices })
+        let faces = faces(&planes, &vertices);
+        Some(Polyhedron { planes, vertices, faces })
     }
 
     /// The axis-aligned box `[lo, hi]`.
     pub fn cuboid(lo: Vec3, hi: Vec3) -> Polyhedron {
         let planes: Vec<Plane> =
             (0..3).flat_map(|a| [Plane { normal: Vec3::AXES[a], offset: hi[a] }, Plane { normal: -Vec3::AXES[a], offset: -lo[a] }]).collect();
-        let vertices = (0..8)
+        let vertices: Vec<Vec3> = (0..8)
             .map(|c: usize| Vec3::new(if c & 1 == 0 { lo.x } else { hi.x }, if c & 2 == 0 { lo.y } else { hi.y }, if c & 4 == 0 { lo.z } else { hi.z }))
             .collect();
-        Polyhedron { planes, vertices }
+        let faces = faces(&planes, &vertices);
+        Polyhedron { planes, vertices, faces }
     }
 
     /// The two halves on either side of `plane` (the one `plane` keeps first), or `None`
@@ -62,7 +66,7 @@ impl Polyhedron {
 
     /// The centroid of the solid (tetrahedra from the vertex mean to each face).
     pub fn centroid(&self) -> Vec3 {
-        let (volume, moment) = self.faces().iter().fold((0.0f64, glam::DVec3::ZERO), |(v, m), face| {
+        let (volume, moment) = self.faces.iter().fold((0.0f64, glam::DVec3::ZERO), |(v, m), face| {
             let apex = self.vertex_mean().as_dvec3();
             let (a, fan) = (face[0].as_dvec3(), &face[1..]);
             fan.windows(2).fold((v, m), |(v, m), e| {
@@ -77,7 +81,7 @@ impl Polyhedron {
     /// The volume of the solid.
     pub fn volume(&self) -> f32 {
         let apex = self.vertex_mean().as_dvec3();
-        self.faces()
+        self.faces
             .iter()
             .map(|face| {
                 let a = face[0].as_dvec3();
@@ -89,26 +93,6 @@ impl Polyhedron {
     /// The mean of the vertices.
     pub fn vertex_mean(&self) -> Vec3 {
         self.vertices.iter().copied().sum::<Vec3>() / self.vertices.len().max(1) as f32
-    }
-
-    /// Each face's vertices in order around it.
-    pub fn faces(&self) -> Vec<Vec<Vec3>> {
-        let scale = self.vertices.iter().map(|v| v.length()).fold(1.0, f32::max);
-        self.planes
-            .iter()
-            .filter_map(|pl| {
-                let on: Vec<Vec3> = self.vertices.iter().copied().filter(|v| pl.distance(*v).abs() <= 1e-4 * scale).collect();
-                if on.len() < 3 {
-                    return None;
-                }
-                let c = on.iter().copied().sum::<Vec3>() / on.len() as f32;
-                let u = (on[0] - c).normalize_or_zero();
-                let w = pl.normal.cross(u);
-                let mut sorted = on;
-                sorted.sort_by(|a, b| (*a - c).dot(w).atan2((*a - c).dot(u)).total_cmp(&(*b - c).dot(w).atan2((*b - c).dot(u))));
-                Some(sorted)
-            })
-            .collect()
     }
 
     /// Whether a point lies inside (boundary included).
@@ -128,7 +112,7 @@ impl Polyhedron {
                 best = q;
             }
         };
-        for face in self.faces() {
+        for face in &self.faces {
             let n = (face[1] - face[0]).cross(face[2] - face[0]).normalize_or_zero();
             let q = p - n * (p - face[0]).dot(n);
             if self.contains(q) {
@@ -143,6 +127,28 @@ impl Polyhedron {
         }
         best
     }
+}
+
+/// Each plane's face: the vertices on it in order around it (planes with fewer than
+/// three vertices on them have none).
+fn faces(planes: &[Plane], vertices: &[Vec3]) -> Vec<Vec<Vec3>> {
+    let scale = vertices.iter().map(|v| v.length()).fold(1.0, f32::max);
+    planes
+        .iter()
+        .filter_map(|pl| {
+            let on: Vec<Vec3> = vertices.iter().copied().filter(|v| pl.distance(*v).abs() <= 1e-4 * scale).collect();
+            if on.len() < 3 {
+                return None;
+            }
+            let c = on.iter().copied().sum::<Vec3>() / on.len() as f32;
+            let u = (on[0] - c).normalize_or_zero();
+            let w = pl.normal.cross(u);
+            let angle = |a: &Vec3| (*a - c).dot(w).atan2((*a - c).dot(u));
+            let mut sorted = on;
+            sorted.sort_by(|a, b| angle(a).total_cmp(&angle(b)));
+            Some(sorted)
+        })
+        .collect()
 }
 
 /// Vertices without the near-duplicates where more than three planes meet.
@@ -201,7 +207,7 @@ mod tests {
         // centroid at (⅓, ⅓, ½)).
         let (wedge, _) = Polyhedron::cuboid(Vec3::ZERO, Vec3::ONE).split(Plane::through(Vec3::new(0.5, 0.5, 0.0), Vec3::new(1.0, 1.0, 0.0))).unwrap();
         assert_eq!(wedge.vertices.len(), 6);
-        assert_eq!(wedge.faces().len(), 5);
+        assert_eq!(wedge.faces.len(), 5);
         assert!((wedge.volume() - 0.5).abs() < 1e-5);
         assert!((wedge.centroid() - Vec3::new(1.0 / 3.0, 1.0 / 3.0, 0.5)).length() < 1e-5, "{}", wedge.centroid());
         // Closest points: inside itself; beyond the slanted face its foot; beyond an

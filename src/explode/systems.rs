@@ -1,0 +1,271 @@
+//! The exploded view's systems: parts and their rapier bodies, the forces of every step,
+//! and parts as regions.
+//!
+//! The physics runs in a schedule of its own, [`ExplodeStep`]: one run is one rapier
+//! step of `1 / steps_per_second` seconds ([`ExplodeTiming`]), the forces applied just
+//! before it. The app runs as many steps a frame as the frame's time asks for (at most
+//! `max_steps_per_frame`); tests and scripted scenes call [`step`] by hand. Parts do not
+//! collide (they start touching everywhere; the spacing force keeps them apart).
+
+use bevy::ecs::schedule::ScheduleLabel;
+use bevy::prelude::*;
+use bevy_rapier3d::prelude::*;
+use bevy_rapier3d::rapier::dynamics::IntegrationParameters;
+
+use super::components::{ExplodeTiming, Exploded, ExplosionPoints, Part};
+use super::forces::{PartNow, Scale, Surroundings, part_wrench};
+use super::parts::Polyhedron;
+use super::points::explosion_points;
+use super::regions::{PlacedPart, part_regions};
+use crate::dataset::{Dataset, GpuVolume, RegionSystems, SceneRegions};
+use crate::region::box_planes;
+use crate::transfer::Lut;
+use crate::volume::Volume;
+use crate::windows::Viewer;
+
+/// The schedule of one physics step.
+#[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
+pub struct ExplodeStep;
+
+/// Exploded views (no GPU needed): rapier in [`ExplodeStep`], zero gravity, millimetres.
+pub struct ExplodePlugin;
+
+impl Plugin for ExplodePlugin {
+    fn build(&self, app: &mut App) {
+        let timing = ExplodeTiming::default();
+        let init = RapierContextInitialization::InitializeDefaultRapierContext {
+            integration_parameters: IntegrationParameters { length_unit: 1000.0, ..default() },
+            rapier_configuration: RapierConfiguration { gravity: Vec3::ZERO, ..RapierConfiguration::new(1000.0) },
+        };
+        app.add_plugins(RapierPhysicsPlugin::<NoUserData>::default().with_custom_initialization(init).in_schedule(ExplodeStep))
+            .insert_resource(TimestepMode::Fixed { dt: 1.0 / timing.steps_per_second, substeps: 1 })
+            .insert_resource(timing)
+            .add_systems(ExplodeStep, apply_forces.before(PhysicsSet::SyncBackend))
+            .add_systems(Update, (ensure_parts, update_points, sync_bodies).chain())
+            .add_systems(PostUpdate, exploded_regions.in_set(RegionSystems::Modify).before(crate::windows::systems::window_regions));
+    }
+}
+
+/// Runs `n` physics steps.
+pub fn step(world: &mut World, n: u32) {
+    for _ in 0..n {
+        world.run_schedule(ExplodeStep);
+    }
+}
+
+/// The app's stepping: as many steps as the frame's time asks for (the app adds it;
+/// headless apps step by hand with [`step`]).
+pub fn run_steps(world: &mut World) {
+    let any = world.query_filtered::<(), With<Part>>().iter(world).next().is_some();
+    if !any {
+        return;
+    }
+    let timing = *world.resource::<ExplodeTiming>();
+    let dt = world.resource::<Time>().delta_secs();
+    let n = ((dt * timing.steps_per_second).round() as u32).clamp(1, timing.max_steps_per_frame);
+    step(world, n);
+}
+
+/// The volume the dataset's parts show (the GPU's copy when it had to be reduced).
+fn shown(d: &Dataset, gpu: Option<&GpuVolume>) -> std::sync::Arc<Volume> {
+    gpu.map(|g| g.volume.clone()).unwrap_or_else(|| d.volume.clone())
+}
+
+/// The box of a volume's voxel cells in its own frame.
+pub fn volume_polyhedron(volume: &Volume) -> Option<Polyhedron> {
+    Polyhedron::new(&box_planes(&volume.grid.world_to_index(), Vec3::splat(-0.5), volume.dims().as_vec3() - 0.5))
+}
+
+/// Stiffness of the return spring near rest, per unit mass (1/s²): a part of default
+/// density settles back in about a third of a second.
+const STIFFNESS: f32 = 30.0;
+
+/// The units of the forces on a part of `volume`'s dataset that fills `share` of its box:
+/// `ℓ` a quarter of the box's diagonal, and a unit force that gives the part, at the
+/// default density, an acceleration of 30 ℓ/s². Forces grow with a part's size, so parts
+/// of any size move alike; a denser (heavier) part moves less.
+pub fn force_scale(volume: &Volume, share: f32) -> Scale {
+    let (lo, hi) = volume.grid.world_bounds();
+    let length = (hi - lo).length() / 4.0;
+    Scale { length, force: STIFFNESS * length * share }
+}
+
+/// Damping that makes the return spring critically damped near rest for a part of
+/// `density` times the default (linear and angular, 1/s: `2√(k/m)`, the angular
+/// stiffness of a box-like part about 4.5 times the linear one per inertia).
+fn damping(density: f32) -> Damping {
+    let per = (STIFFNESS / density.max(1e-3)).sqrt();
+    Damping { linear_damping: 2.0 * per, angular_damping: 2.0 * 2.2 * per }
+}
+
+/// Density giving the whole box of `volume` a mass of 1.
+fn base_density(volume: &Volume) -> f32 {
+    let e = volume.grid.extent();
+    1.0 / (e.x * e.y * e.z).max(1e-9)
+}
+
+/// The rapier components of a part.
+fn body(part: &Part, volume: &Volume) -> impl Bundle {
+    let collider = Collider::convex_hull(&part.rest.vertices).unwrap_or_else(|| Collider::ball(1.0));
+    (
+        if part.fixed { RigidBody::Fixed } else { RigidBody::Dynamic },
+        collider,
+        ColliderMassProperties::Density(part.density * base_density(volume)),
+        damping(part.density),
+        Sleeping::disabled(),
+        CollisionGroups::new(Group::GROUP_2, Group::NONE),
+        ExternalForce::default(),
+        Velocity::default(),
+    )
+}
+
+/// Gives each exploded dataset without parts its first part: its whole box.
+pub fn ensure_parts(mut commands: Commands, datasets: Query<(Entity, &Dataset), With<Exploded>>, parts: Query<&Part>) {
+    for (e, d) in &datasets {
+        if parts.iter().any(|p| p.dataset == e) {
+            continue;
+        }
+        let Some(rest) = volume_polyhedron(&d.volume) else { continue };
+        let part = Part::new(e, rest);
+        commands.spawn((body(&part, &d.volume), part, Transform::default()));
+    }
+}
+
+/// Spawns `part` (of a dataset showing `volume`) at rest with its rapier body.
+pub fn spawn_part(world: &mut World, part: Part, motion: Transform) -> Entity {
+    let volume = world.get::<Dataset>(part.dataset).map(|d| d.volume.clone());
+    let mut e = world.spawn((part.clone(), motion));
+    if let Some(v) = volume {
+        e.insert(body(&part, &v));
+    }
+    e.id()
+}
+
+/// Keeps each part's body kind and mass in step with it (infinite mass = fixed).
+#[allow(clippy::type_complexity)]
+pub fn sync_bodies(
+    mut parts: Query<(&Part, &mut RigidBody, &mut ColliderMassProperties, &mut Damping, &mut ExternalForce), Changed<Part>>,
+    datasets: Query<&Dataset>,
+) {
+    for (p, mut body, mut mass, mut damp, mut force) in &mut parts {
+        let d = damping(p.density);
+        if *damp != d {
+            *damp = d;
+        }
+        let kind = if p.fixed { RigidBody::Fixed } else { RigidBody::Dynamic };
+        if *body != kind {
+            *body = kind;
+            force.set_changed();
+        }
+        if let Ok(d) = datasets.get(p.dataset) {
+            let m = ColliderMassProperties::Density(p.density * base_density(&d.volume));
+            if *mass != m {
+                *mass = m;
+            }
+        }
+    }
+}
+
+/// Recomputes the explosion points of datasets whose selection or look changed.
+#[allow(clippy::type_complexity)]
+pub fn update_points(
+    mut commands: Commands,
+    datasets: Query<(Entity, &Dataset, &Exploded, Option<&ExplosionPoints>), Or<(Changed<Exploded>, Changed<Dataset>, Without<ExplosionPoints>)>>,
+) {
+    for (e, d, x, old) in &datasets {
+        let points = match &x.selection {
+            Some(sel) => {
+                let v = &d.volume;
+                let map = &v.values;
+                let lut = match &d.appearance.lookup {
+                    crate::region::Lookup::Transfer(tf) => Some(Lut::for_volume(tf, v)),
+                    crate::region::Lookup::Labels(_) => None,
+                };
+                let visible =
+                    |lo: u16, hi: u16| lut.as_ref().is_none_or(|l| l.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0);
+                explosion_points(&v.grid, v.bricks(), sel.volume.bricks(), visible, x.max_points)
+            }
+            None => Vec::new(),
+        };
+        let new = ExplosionPoints { points };
+        if old != Some(&new) {
+            commands.entity(e).insert(new);
+        }
+    }
+}
+
+/// Sets every part's external force and torque for the coming step (equations 1–5, in
+/// the dataset's frame).
+#[allow(clippy::type_complexity)]
+pub fn apply_forces(
+    mut parts: Query<(Entity, &Part, &Transform, &mut ExternalForce)>,
+    datasets: Query<(&Dataset, &Exploded, Option<&ExplosionPoints>, &GlobalTransform)>,
+    viewers: Query<&GlobalTransform, With<Viewer>>,
+) {
+    let viewer = viewers.iter().next().map(|g| g.translation());
+    // Each dataset's parts, in entity order, with their centres now.
+    let mut by_dataset: std::collections::BTreeMap<Entity, Vec<(Entity, Vec3)>> = Default::default();
+    for (e, p, t, _) in &parts {
+        by_dataset.entry(p.dataset).or_default().push((e, t.transform_point(p.rest.centroid())));
+    }
+    for (dataset, members) in &by_dataset {
+        let Ok((d, x, points, global)) = datasets.get(*dataset) else { continue };
+        let centers: Vec<Vec3> = members.iter().map(|m| m.1).collect();
+        let eye = if x.viewing { viewer.map(|v| global.affine().inverse().transform_point3(v)) } else { None };
+        let empty = ExplosionPoints::default();
+        let around = Surroundings { points: &points.unwrap_or(&empty).points, centers: &centers, eye };
+        let e = d.volume.grid.extent();
+        let box_volume = (e.x * e.y * e.z).max(1e-9);
+        for (index, (e, center)) in members.iter().enumerate() {
+            let Ok((_, p, t, mut force)) = parts.get_mut(*e) else { continue };
+            if p.fixed {
+                continue;
+            }
+            let scale = force_scale(&d.volume, p.rest.volume() / box_volume);
+            let now = PartNow { index, rest: &p.rest, to_world: t.compute_affine(), center_of_mass: *center };
+            let w = part_wrench(&now, &around, &x.coefficients, scale);
+            let f = ExternalForce { force: w.force, torque: w.torque };
+            if *force != f {
+                *force = f;
+            }
+        }
+    }
+}
+
+/// Replaces each exploded dataset's region by its parts' regions.
+pub fn exploded_regions(
+    parts: Query<(&Part, &Transform)>,
+    datasets: Query<(Entity, &Dataset, Option<&GpuVolume>, &GlobalTransform), With<Exploded>>,
+    mut out: ResMut<SceneRegions>,
+) {
+    if datasets.is_empty() {
+        return;
+    }
+    let mut scene = out.scene.clone();
+    let mut changed = false;
+    // Each exploded dataset's region (the one showing its volume), from the last back so
+    // earlier indices stay valid.
+    let mut targets: Vec<(usize, usize, Entity)> = datasets
+        .iter()
+        .filter_map(|(e, ..)| {
+            let volume = out.datasets.iter().position(|d| *d == e)?;
+            let region = scene.regions.iter().position(|r| r.volume == volume)?;
+            Some((region, volume, e))
+        })
+        .collect();
+    targets.sort_by(|a, b| b.0.cmp(&a.0));
+    for (region_index, volume_index, entity) in targets {
+        let Ok((_, d, gpu, global)) = datasets.get(entity) else { continue };
+        if parts.iter().all(|(p, _)| p.dataset != entity) {
+            continue;
+        }
+        let placed: Vec<PlacedPart> =
+            parts.iter().filter(|(p, _)| p.dataset == entity && !p.hidden).map(|(p, t)| PlacedPart { rest: &p.rest, motion: t.compute_affine() }).collect();
+        let regions = part_regions(&shown(d, gpu).grid, global.affine(), &d.clip, volume_index, &placed);
+        scene.regions.splice(region_index..=region_index, regions);
+        changed = true;
+    }
+    if changed && out.scene != scene {
+        out.scene = scene;
+    }
+}

@@ -1,0 +1,193 @@
+//! Exploded views in a headless app: parts as rapier bodies stepped by hand.
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+use focal::FocalCorePlugins;
+use focal::dataset::Dataset;
+use focal::explode::systems::{spawn_part, volume_polyhedron};
+use focal::explode::{Exploded, ExplosionPoints, Part, step};
+use focal::region::{Appearance, Mode, Plane, ray_convex};
+use focal::transfer::presets;
+use focal::volume::phantom::Phantom;
+use focal::volume::{SelectionVolume, Volume};
+
+fn app() -> App {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, TransformPlugin, FocalCorePlugins));
+    app
+}
+
+/// A sphere of radius `r` mm at the centre of `volume`'s grid selected.
+fn central_selection(volume: &Volume, r: f32) -> SelectionVolume {
+    let g = &volume.grid;
+    let to_world = g.index_to_world();
+    let codes = (0..g.voxel_count())
+        .map(|i| {
+            let (x, y, z) = (i as u32 % g.dims.x, i as u32 / g.dims.x % g.dims.y, i as u32 / (g.dims.x * g.dims.y));
+            let p = to_world.transform_point3(Vec3::new(x as f32, y as f32, z as f32));
+            if p.distance(g.center()) <= r { 255 } else { 0 }
+        })
+        .collect();
+    SelectionVolume::from_codes(g.clone(), codes).unwrap()
+}
+
+/// The head CT (64³, 240 mm) exploded around a 40 mm sphere at its centre, its box
+/// split into `n`³ parts by planes along the axes. Returns the dataset and the parts.
+fn exploded_head(app: &mut App, n: u32) -> (Entity, Vec<Entity>) {
+    let v = Arc::new(Phantom::Head.generate(64).unwrap());
+    let selection = Arc::new(central_selection(&v, 40.0));
+    let a = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap());
+    let exploded = Exploded { selection: Some(selection), ..Default::default() };
+    let dataset = app.world_mut().spawn((Dataset::new(v.clone(), a), Transform::default(), exploded)).id();
+    let mut pieces = vec![volume_polyhedron(&v).unwrap()];
+    let (lo, hi) = v.grid.world_bounds();
+    for axis in 0..3 {
+        for k in 1..n {
+            let at = lo[axis] + (hi[axis] - lo[axis]) * k as f32 / n as f32;
+            let plane = Plane { normal: Vec3::AXES[axis], offset: at };
+            pieces = pieces.into_iter().flat_map(|p| p.split(plane).map_or_else(|| vec![p.clone()], |(a, b)| vec![a, b])).collect();
+        }
+    }
+    assert_eq!(pieces.len(), (n * n * n) as usize);
+    let parts = pieces.into_iter().map(|rest| spawn_part(app.world_mut(), Part::new(dataset, rest), Transform::default())).collect();
+    app.update();
+    (dataset, parts)
+}
+
+fn motion(app: &App, part: Entity) -> Transform {
+    *app.world().get::<Transform>(part).unwrap()
+}
+
+fn set_degree(app: &mut App, dataset: Entity, degree: f32) {
+    app.world_mut().get_mut::<Exploded>(dataset).unwrap().coefficients.degree = degree;
+}
+
+fn centre(app: &App, part: Entity) -> Vec3 {
+    let p = app.world().get::<Part>(part).unwrap();
+    motion(app, part).transform_point(p.rest.centroid())
+}
+
+/// The share of the explosion points that some part hides from `eye` (the segment from
+/// the eye to the point crosses a part before it).
+fn hidden_share(app: &App, dataset: Entity, parts: &[Entity], eye: Vec3) -> f32 {
+    let points = &app.world().get::<ExplosionPoints>(dataset).unwrap().points;
+    let hidden = points
+        .iter()
+        .filter(|p| {
+            let to = p.position - eye;
+            parts.iter().any(|&e| {
+                let part = app.world().get::<Part>(e).unwrap();
+                let m = motion(app, e).compute_affine();
+                let planes: Vec<Plane> =
+                    part.rest.planes.iter().map(|pl| focal::explode::splitters::in_part_frame(*pl, m.inverse())).collect();
+                ray_convex(&planes, eye, to).is_some_and(|(t0, t1)| t1 > 0.0 && t0 < 0.999)
+            })
+        })
+        .count();
+    hidden as f32 / points.len().max(1) as f32
+}
+
+#[test]
+fn at_degree_zero_every_part_stays_in_place() {
+    let mut app = app();
+    let (_, parts) = exploded_head(&mut app, 2);
+    step(app.world_mut(), 300);
+    for p in parts {
+        let t = motion(&app, p);
+        assert!(t.translation.length() < 1e-3 && t.rotation.angle_between(Quat::IDENTITY) < 1e-4, "{t:?}");
+    }
+}
+
+#[test]
+fn raising_the_degree_moves_parts_off_the_selection_and_back() {
+    let mut app = app();
+    let (dataset, parts) = exploded_head(&mut app, 2);
+    let points = app.world().get::<ExplosionPoints>(dataset).unwrap().points.clone();
+    // Within the bricks the 40 mm sphere touches (30 mm bricks, with their aprons).
+    assert!(!points.is_empty() && points.iter().all(|p| p.position.length() < 40.0 + 30.0 * 3f32.sqrt()), "{points:?}");
+    let eye = Vec3::new(40.0, 600.0, 90.0);
+    let before: Vec<f32> = parts.iter().map(|p| centre(&app, *p).length()).collect();
+    let hidden_before = hidden_share(&app, dataset, &parts, eye);
+    assert!(hidden_before > 0.99, "at rest the parts hide the selection: {hidden_before}");
+    set_degree(&mut app, dataset, 1.0);
+    step(app.world_mut(), 600);
+    let after: Vec<f32> = parts.iter().map(|p| centre(&app, *p).length()).collect();
+    for (b, a) in before.iter().zip(&after) {
+        assert!(a > &(b + 10.0), "every part moved away from the selection: {b} → {a}");
+    }
+    let hidden_after = hidden_share(&app, dataset, &parts, eye);
+    assert!(hidden_after < 0.75 * hidden_before, "the selection shows: {hidden_before} → {hidden_after}");
+    // A higher degree moves them further, and shows more of the selection.
+    set_degree(&mut app, dataset, 2.0);
+    step(app.world_mut(), 600);
+    let further: Vec<f32> = parts.iter().map(|p| centre(&app, *p).length()).collect();
+    assert!(further.iter().zip(&after).all(|(f, a)| f > a), "{after:?} → {further:?}");
+    let hidden_further = hidden_share(&app, dataset, &parts, eye);
+    assert!(hidden_further < hidden_after, "{hidden_after} → {hidden_further}");
+    // Back to 0: every part returns to its place.
+    set_degree(&mut app, dataset, 0.0);
+    step(app.world_mut(), 2000);
+    for p in &parts {
+        let t = motion(&app, *p);
+        assert!(t.translation.length() < 0.5 && t.rotation.angle_between(Quat::IDENTITY) < 1e-2, "{t:?}");
+    }
+}
+
+#[test]
+fn a_part_of_infinite_mass_never_moves() {
+    let mut app = app();
+    let (dataset, parts) = exploded_head(&mut app, 2);
+    app.world_mut().get_mut::<Part>(parts[0]).unwrap().fixed = true;
+    app.update();
+    set_degree(&mut app, dataset, 2.0);
+    step(app.world_mut(), 400);
+    assert_eq!(motion(&app, parts[0]), Transform::default(), "the fixed part");
+    assert!(motion(&app, parts[1]).translation.length() > 5.0, "the others move");
+}
+
+#[test]
+fn parts_become_regions_that_carry_their_data() {
+    let mut app = app();
+    let (dataset, parts) = exploded_head(&mut app, 2);
+    set_degree(&mut app, dataset, 1.0);
+    step(app.world_mut(), 300);
+    app.update();
+    let scene = app.world().resource::<focal::dataset::SceneRegions>().scene.clone();
+    assert_eq!(scene.regions.len(), parts.len(), "one region per part");
+    // Each part's centre maps back to where it was at rest.
+    for e in &parts {
+        let part = app.world().get::<Part>(*e).unwrap();
+        let now = centre(&app, *e);
+        let holding: Vec<_> = scene.regions.iter().filter(|r| r.contains(now)).collect();
+        assert_eq!(holding.len(), 1, "one part holds each centre");
+        let g = &app.world().get::<Dataset>(dataset).unwrap().volume.grid;
+        let rest_voxel = g.world_to_index().transform_point3(part.rest.centroid());
+        assert!((holding[0].world_to_voxel.transform_point3(now) - rest_voxel).length() < 1e-2);
+    }
+    // A hidden part draws nothing.
+    app.world_mut().get_mut::<Part>(parts[0]).unwrap().hidden = true;
+    app.update();
+    assert_eq!(app.world().resource::<focal::dataset::SceneRegions>().scene.regions.len(), parts.len() - 1);
+}
+
+#[test]
+fn sixty_four_parts_stay_stable_for_ten_thousand_steps() {
+    let mut app = app();
+    let (dataset, parts) = exploded_head(&mut app, 4);
+    let diagonal = 240.0 * 3f32.sqrt();
+    for round in 0..10 {
+        // The degree goes up and down, as a user drags the slider.
+        set_degree(&mut app, dataset, [0.0, 1.0, 3.0, 0.5, 2.0, 0.0, 3.0, 3.0, 1.0, 0.0][round]);
+        step(app.world_mut(), 1000);
+        for p in &parts {
+            let t = motion(&app, *p);
+            assert!(t.translation.is_finite() && t.rotation.is_finite(), "round {round}: {t:?}");
+            assert!(t.translation.length() < 2.0 * diagonal, "round {round}: a part flew off to {}", t.translation);
+        }
+    }
+    // Ended at degree 0: all back.
+    let worst = parts.iter().map(|p| motion(&app, *p).translation.length()).fold(0.0, f32::max);
+    assert!(worst < 1.0, "{worst} mm off");
+}
+
