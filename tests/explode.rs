@@ -117,14 +117,14 @@ fn raising_the_degree_moves_parts_off_the_selection_and_back() {
         assert!(a > &(b + 10.0), "every part moved away from the selection: {b} → {a}");
     }
     let hidden_after = hidden_share(&app, dataset, &parts, eye);
-    assert!(hidden_after < 0.75 * hidden_before, "the selection shows: {hidden_before} → {hidden_after}");
+    assert!(hidden_after < 0.9 * hidden_before, "the selection shows: {hidden_before} → {hidden_after}");
     // A higher degree moves them further, and shows more of the selection.
     set_degree(&mut app, dataset, 2.0);
     step(app.world_mut(), 600);
     let further: Vec<f32> = parts.iter().map(|p| centre(&app, *p).length()).collect();
     assert!(further.iter().zip(&after).all(|(f, a)| f > a), "{after:?} → {further:?}");
     let hidden_further = hidden_share(&app, dataset, &parts, eye);
-    assert!(hidden_further < hidden_after, "{hidden_after} → {hidden_further}");
+    assert!(hidden_further < hidden_after && hidden_further < 0.6, "{hidden_after} → {hidden_further}");
     // Back to 0: every part returns to its place.
     set_degree(&mut app, dataset, 0.0);
     step(app.world_mut(), 2000);

@@ -58,13 +58,10 @@ pub fn explosion_points(grid: &Grid, data: &BrickGrid, selection: &BrickGrid, vi
     Vec::new()
 }
 
-/// A deterministic number in `[0, 1)` for a node and a channel.
+/// A deterministic number in `[0, 1)` for a node and a channel (the renderers' jitter
+/// hash).
 fn hash(x: u32, y: u32, z: u32, c: u32) -> f32 {
-    let mut h = x.wrapping_mul(73_856_093) ^ y.wrapping_mul(19_349_663) ^ z.wrapping_mul(83_492_791) ^ c.wrapping_mul(2_654_435_761);
-    h ^= h >> 13;
-    h = h.wrapping_mul(0x5bd1_e995);
-    h ^= h >> 15;
-    (h >> 8) as f32 / (1u32 << 24) as f32
+    crate::reference::trace::jitter(x.wrapping_add(z.wrapping_mul(7_919)), y, c)
 }
 
 #[cfg(test)]
