@@ -36,9 +36,8 @@ fn central_selection(volume: &Volume, r: f32) -> SelectionVolume {
 /// split into `n`³ parts by planes along the axes. Returns the dataset and the parts.
 fn exploded_head(app: &mut App, n: u32) -> (Entity, Vec<Entity>) {
     let v = Arc::new(Phantom::Head.generate(64).unwrap());
-    let selection = Arc::new(central_selection(&v, 40.0));
     let a = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap());
-    let exploded = Exploded { selection: Some(selection), ..Default::default() };
+    let exploded = Exploded::around(&central_selection(&v, 40.0));
     let dataset = app.world_mut().spawn((Dataset::new(v.clone(), a), Transform::default(), exploded)).id();
     let mut pieces = vec![volume_polyhedron(&v).unwrap()];
     let (lo, hi) = v.grid.world_bounds();
@@ -154,7 +153,11 @@ fn parts_become_regions_that_carry_their_data() {
     step(app.world_mut(), 300);
     app.update();
     let scene = app.world().resource::<focal::dataset::SceneRegions>().scene.clone();
-    assert_eq!(scene.regions.len(), parts.len(), "one region per part");
+    assert_eq!(scene.regions.len(), parts.len() + 1, "one region per part, then the selection's");
+    let keep = |r: &focal::region::Region| scene.appearances[r.appearance].selection.as_ref().map(|w| w.keep);
+    assert!(scene.regions[..parts.len()].iter().all(|r| keep(r) == Some(focal::region::Keep::Unselected)));
+    assert_eq!(keep(&scene.regions[parts.len()]), Some(focal::region::Keep::Selected));
+    let scene = focal::region::RenderScene { regions: scene.regions[..parts.len()].to_vec(), ..scene };
     // Each part's centre maps back to where it was at rest.
     for e in &parts {
         let part = app.world().get::<Part>(*e).unwrap();
@@ -168,7 +171,7 @@ fn parts_become_regions_that_carry_their_data() {
     // A hidden part draws nothing.
     app.world_mut().get_mut::<Part>(parts[0]).unwrap().hidden = true;
     app.update();
-    assert_eq!(app.world().resource::<focal::dataset::SceneRegions>().scene.regions.len(), parts.len() - 1);
+    assert_eq!(app.world().resource::<focal::dataset::SceneRegions>().scene.regions.len(), parts.len());
 }
 
 #[test]
@@ -191,3 +194,41 @@ fn sixty_four_parts_stay_stable_for_ten_thousand_steps() {
     assert!(worst < 1.0, "{worst} mm off");
 }
 
+
+#[test]
+fn at_rest_the_exploded_dataset_looks_as_before_and_exploded_its_selection_stays() {
+    use focal::reference::render;
+    use focal::region::{RenderScene, View};
+    let mut app = app();
+    let (dataset, _) = exploded_head(&mut app, 2);
+    app.update();
+    let exploded = app.world().resource::<focal::dataset::SceneRegions>().scene.clone();
+    let d = app.world().get::<Dataset>(dataset).unwrap().clone();
+    let plain = RenderScene::single(d.volume.clone(), d.appearance.clone());
+    let cam = View::Anterior.frame(Vec3::ZERO, 140.0, true);
+    let (a, b) = (render(&plain, &cam, 40, 40).unwrap(), render(&exploded, &cam, 40, 40).unwrap());
+    // The parts draw the data less the selection, the selection the rest: the same
+    // picture but where the degree of interest falls from 1 to 0 (there both draw a
+    // fraction and the two fractions composite to a little less).
+    let diff: Vec<f32> = a.rgba.iter().zip(&b.rgba).map(|(p, q)| (*p - *q).abs().max_element()).collect();
+    let mean = diff.iter().sum::<f32>() / diff.len() as f32;
+    assert!(mean < 0.01, "mean difference {mean}");
+    // Cut open at the front (skin and skull off the selection): seen through a clip plane
+    // the selection's data shows; exploded, the selection alone still draws it where it
+    // was, the parts pushed away.
+    set_degree(&mut app, dataset, 2.0);
+    step(app.world_mut(), 600);
+    app.update();
+    let scene = app.world().resource::<focal::dataset::SceneRegions>().scene.clone();
+    let n = scene.regions.len();
+    let selection_only = RenderScene { regions: scene.regions[n - 1..].to_vec(), ..scene.clone() };
+    let parts_only = RenderScene { regions: scene.regions[..n - 1].to_vec(), ..scene };
+    let (s, p) = (render(&selection_only, &cam, 40, 40).unwrap(), render(&parts_only, &cam, 40, 40).unwrap());
+    let centre = 20 * 40 + 20;
+    assert!(s.alpha[centre] > 0.5, "the selection draws its data at the centre: {}", s.alpha[centre]);
+    let covered = s.alpha.iter().filter(|a| **a > 0.05).count();
+    assert!(covered > 20 && covered < 400, "the 40 mm sphere, not more: {covered} pixels");
+    // And the parts have left the middle of the view (the 2×2×2 octants part along
+    // the axes): its ray meets less of them than it met of the whole head.
+    assert!(p.alpha[centre] < 0.5 * a.alpha[centre], "{} vs {}", p.alpha[centre], a.alpha[centre]);
+}

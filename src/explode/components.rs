@@ -12,7 +12,8 @@ use bevy::prelude::*;
 
 use super::forces::{Coefficients, ExplosionPoint};
 use super::parts::Polyhedron;
-use crate::volume::SelectionVolume;
+use crate::region::Appearance;
+use crate::volume::{SelectionVolume, Volume};
 
 /// Explodes the dataset entity it is on.
 #[derive(Component, Clone)]
@@ -21,16 +22,27 @@ pub struct Exploded {
     pub coefficients: Coefficients,
     /// Whether the viewing force acts (figure 5 of the paper: off and on).
     pub viewing: bool,
-    /// The selection (degree of interest per voxel, on the dataset's grid); `None`:
-    /// nothing selected, no explosion points.
-    pub selection: Option<Arc<SelectionVolume>>,
+    /// The selection: a degree-of-interest volume ([`SelectionVolume::volume`]) placed
+    /// by its grid in the dataset's frame; `None`: nothing selected, no explosion points.
+    /// The parts draw the data less the selection, the selection its own region (not
+    /// moved) with [`Self::selection_look`].
+    pub selection: Option<Arc<Volume>>,
+    /// How the selection is drawn (`None`: as the dataset).
+    pub selection_look: Option<Appearance>,
     /// Most explosion points ([`super::points`]).
     pub max_points: usize,
 }
 
 impl Default for Exploded {
     fn default() -> Self {
-        Exploded { coefficients: Coefficients::default(), viewing: false, selection: None, max_points: 64 }
+        Exploded { coefficients: Coefficients::default(), viewing: false, selection: None, selection_look: None, max_points: 64 }
+    }
+}
+
+impl Exploded {
+    /// Exploded around `selection`.
+    pub fn around(selection: &SelectionVolume) -> Exploded {
+        Exploded { selection: Some(Arc::new(selection.volume.clone())), ..Default::default() }
     }
 }
 

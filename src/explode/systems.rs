@@ -18,7 +18,7 @@ use super::parts::Polyhedron;
 use super::points::explosion_points;
 use super::regions::{PlacedPart, part_regions};
 use crate::dataset::{Dataset, GpuVolume, RegionSystems, SceneRegions};
-use crate::region::box_planes;
+use crate::region::{Appearance, Keep, Region, SelectionWeight, box_planes};
 use crate::transfer::Lut;
 use crate::volume::Volume;
 use crate::windows::Viewer;
@@ -183,7 +183,7 @@ pub fn update_points(
                 };
                 let visible =
                     |lo: u16, hi: u16| lut.as_ref().is_none_or(|l| l.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0);
-                explosion_points(&v.grid, v.bricks(), sel.volume.bricks(), visible, x.max_points)
+                explosion_points(&v.grid, v.bricks(), sel.bricks(), visible, x.max_points)
             }
             None => Vec::new(),
         };
@@ -232,10 +232,12 @@ pub fn apply_forces(
     }
 }
 
-/// Replaces each exploded dataset's region by its parts' regions.
+/// Replaces each exploded dataset's region by its parts' regions (drawing the data less
+/// the selection) and the selection's own region (its box, not moved, drawing the data
+/// in the selection), the parts first.
 pub fn exploded_regions(
     parts: Query<(&Part, &Transform)>,
-    datasets: Query<(Entity, &Dataset, Option<&GpuVolume>, &GlobalTransform), With<Exploded>>,
+    datasets: Query<(Entity, &Dataset, &Exploded, Option<&GpuVolume>, &GlobalTransform)>,
     mut out: ResMut<SceneRegions>,
 ) {
     if datasets.is_empty() {
@@ -255,13 +257,25 @@ pub fn exploded_regions(
         .collect();
     targets.sort_by(|a, b| b.0.cmp(&a.0));
     for (region_index, volume_index, entity) in targets {
-        let Ok((_, d, gpu, global)) = datasets.get(entity) else { continue };
+        let Ok((_, d, x, gpu, global)) = datasets.get(entity) else { continue };
         if parts.iter().all(|(p, _)| p.dataset != entity) {
             continue;
         }
         let placed: Vec<PlacedPart> =
             parts.iter().filter(|(p, _)| p.dataset == entity && !p.hidden).map(|(p, t)| PlacedPart { rest: &p.rest, motion: t.compute_affine() }).collect();
-        let regions = part_regions(&shown(d, gpu).grid, global.affine(), &d.clip, volume_index, &placed);
+        let grid = &shown(d, gpu).grid;
+        let mut regions = part_regions(grid, global.affine(), &d.clip, volume_index, &placed);
+        if let Some(selection) = &x.selection {
+            let weighted = |look: &Appearance, keep: Keep| Appearance { selection: Some(SelectionWeight { volume: selection.clone(), keep }), ..look.clone() };
+            let own = scene.appearances.get(volume_index).cloned().unwrap_or_else(|| d.appearance.clone());
+            scene.appearances.push(weighted(&own, Keep::Unselected));
+            let rest = scene.appearances.len() - 1;
+            for r in &mut regions {
+                r.appearance = rest;
+            }
+            scene.appearances.push(weighted(x.selection_look.as_ref().unwrap_or(&own), Keep::Selected));
+            regions.push(Region { appearance: scene.appearances.len() - 1, ..Region::dataset(grid, global.affine(), &d.clip, volume_index) });
+        }
         scene.regions.splice(region_index..=region_index, regions);
         changed = true;
     }

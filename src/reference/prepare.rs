@@ -69,6 +69,25 @@ pub struct PreparedRegion<'a> {
     pub sphere: (Vec3, f32),
     /// Two-level rendering: the objects of a segmented volume.
     pub objects: Option<PreparedObjects<'a>>,
+    /// Opacity weighted by a selection.
+    pub weight: Option<PreparedWeight<'a>>,
+}
+
+/// A selection weight ready to be sampled.
+pub struct PreparedWeight<'a> {
+    pub weight: &'a crate::region::SelectionWeight,
+    pub sampler: VolumeSampler<'a>,
+    /// Data voxel index → selection voxel index.
+    pub data_to_selection: Affine3A,
+}
+
+impl PreparedWeight<'_> {
+    /// The weight at data voxel `q` (the degree of interest trilinearly sampled).
+    #[inline]
+    pub fn at(&self, q: Vec3) -> f32 {
+        let t = self.sampler.trilinear(self.data_to_selection.transform_point3(q));
+        self.weight.weight(self.weight.volume.normalized_to_real(t as f64) as f32)
+    }
 }
 
 /// The objects of a segmented region ([`crate::twolevel`]), ready to be sampled.
@@ -115,7 +134,7 @@ impl<'a> PreparedRegion<'a> {
     }
 
     /// A region with its appearance, objects left out.
-    fn plain(region: &'a Region, volume: &'a Volume, appearance: &Appearance) -> Self {
+    fn plain(region: &'a Region, volume: &'a Volume, appearance: &'a Appearance) -> Self {
         let labels = matches!(appearance.lookup, Lookup::Labels(_));
         let lookup = match &appearance.lookup {
             Lookup::Transfer(tf) => {
@@ -148,6 +167,11 @@ impl<'a> PreparedRegion<'a> {
             context: appearance.context,
             sphere: bounding_sphere(region, volume),
             objects: None,
+            weight: appearance.selection.as_ref().map(|w| PreparedWeight {
+                weight: w,
+                sampler: VolumeSampler::of(&w.volume),
+                data_to_selection: w.volume.grid.world_to_index() * volume.grid.index_to_world(),
+            }),
         }
     }
 

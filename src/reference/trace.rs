@@ -8,7 +8,8 @@
 //!    voxel centres exactly).
 //! 3. At each sample, every region whose interval contains it contributes, in region
 //!    order (overlapping regions combine sample by sample):
-//!    - DVR: `rgba = TF(f(q))`, opacity corrected for the step,
+//!    - DVR: `rgba = TF(f(q))` (its opacity times a selection's weight when the
+//!      appearance has one: `region::SelectionWeight`), opacity corrected for the step,
 //!      `α = 1 − (1 − α_TF)^(Δ_native/Δ₀)`, colour Blinn-Phong shaded with the gradient
 //!      normal, composited front to back `C += (1 − A)·α·c`, `A += (1 − A)·α`;
 //!    - gradient-modulated DVR: as DVR with `α ·= |∇f| / max|∇f|`;
@@ -231,10 +232,11 @@ fn sample(out: &mut Traced, r: &PreparedRegion, g: &mut Gathered, ratio: f32, q:
             }
             let v = r.sample(q, level);
             let rgba = r.lookup.classify(v, r.sampler.nearest(q));
-            if rgba[3] <= 0.0 {
+            let a = r.weight.as_ref().map_or(rgba[3], |w| rgba[3] * w.at(q));
+            if a <= 0.0 {
                 return;
             }
-            let mut alpha = opacity::correct(rgba[3], ratio);
+            let mut alpha = opacity::correct(a, ratio);
             let grad = r.index_gradient_at(q, level);
             let gradient = (grad.length() / r.gradient_max).min(1.0);
             let world_g = r.normal_matrix * grad;

@@ -101,6 +101,64 @@ pub enum Lookup {
     Labels(LabelTransfer),
 }
 
+/// Which samples a selection weight keeps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Keep {
+    /// Opacity × the degree of interest: the selection (an exploded view's focus).
+    Selected,
+    /// Opacity × (1 − the degree of interest): the rest (an exploded view's parts).
+    Unselected,
+}
+
+/// Opacity weighted by a selection volume's degree of interest (Bruckner and Gröller
+/// 2006, section 4: the parts draw the data less the selection, the selection's own
+/// region the data in it). The selection is placed by its grid in the data volume's
+/// frame, like a segmentation's labels, so it follows the data through any region map.
+/// The transfer function's opacity is weighted before the step correction; modes that
+/// do not composite samples (projections, iso-surfaces) ignore the weight.
+#[derive(Clone, Debug)]
+pub struct SelectionWeight {
+    /// Degree of interest in `[0, 1]` (a [`crate::volume::SelectionVolume`]'s volume).
+    pub volume: std::sync::Arc<Volume>,
+    pub keep: Keep,
+}
+
+/// Equal when they use the same selection (the same shared data) alike.
+impl PartialEq for SelectionWeight {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.volume, &other.volume) && self.keep == other.keep
+    }
+}
+
+impl SelectionWeight {
+    /// Refines the occupancy of `volume`'s bricks: a brick whose selection range gives
+    /// weight 0 throughout (none selected for [`Keep::Selected`], all for
+    /// [`Keep::Unselected`]) adds nothing. Only when the selection lies on the volume's
+    /// own grid (its bricks are then the same); otherwise the occupancy stays.
+    pub fn brick_occupancy(&self, volume: &Volume, mut occupancy: Vec<bool>) -> Vec<bool> {
+        let (data, sel) = (volume.bricks(), self.volume.bricks());
+        if self.volume.grid != volume.grid || data.dims != sel.dims || data.size != sel.size || occupancy.len() != sel.len() {
+            return occupancy;
+        }
+        let doi = |code: u16| self.volume.values.to_real(code as f64) as f32;
+        for (i, o) in occupancy.iter_mut().enumerate() {
+            *o &= match self.keep {
+                Keep::Selected => doi(sel.max[i]) > 0.0,
+                Keep::Unselected => doi(sel.min[i]) < 1.0,
+            };
+        }
+        occupancy
+    }
+
+    /// The weight of a degree of interest.
+    pub fn weight(&self, doi: f32) -> f32 {
+        match self.keep {
+            Keep::Selected => doi.clamp(0.0, 1.0),
+            Keep::Unselected => 1.0 - doi.clamp(0.0, 1.0),
+        }
+    }
+}
+
 /// The appearance of a region.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Appearance {
@@ -116,6 +174,8 @@ pub struct Appearance {
     /// Two-level rendering ([`crate::twolevel`]): a label volume splits the data into
     /// objects with their own modes; this appearance then draws the rest.
     pub segmentation: Option<Segmentation>,
+    /// Opacity weighted by a selection ([`SelectionWeight`]).
+    pub selection: Option<SelectionWeight>,
 }
 
 impl Appearance {
@@ -128,6 +188,7 @@ impl Appearance {
             iso_value: 0.0,
             context: ContextParams::default(),
             segmentation: None,
+            selection: None,
         }
     }
 
@@ -137,9 +198,13 @@ impl Appearance {
     /// sample (projections, iso-surfaces). Segmented volumes: see
     /// [`Segmentation::brick_occupancy`].
     pub fn brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {
-        match &self.segmentation {
+        let occupancy = match &self.segmentation {
             Some(seg) => Some(seg.brick_occupancy(volume, self.own_brick_occupancy(volume))),
             None => self.own_brick_occupancy(volume),
+        };
+        match (&self.selection, occupancy) {
+            (Some(w), Some(occupancy)) => Some(w.brick_occupancy(volume, occupancy)),
+            (_, occupancy) => occupancy,
         }
     }
 

@@ -14,7 +14,7 @@ pub mod scene;
 
 use glam::{Affine3A, Vec3};
 
-pub use appearance::{Appearance, Light, Lookup, Mode, Shading};
+pub use appearance::{Appearance, Keep, Light, Lookup, Mode, SelectionWeight, Shading};
 pub use camera::{Camera, Orbit, Projection, Ray, View};
 pub use scene::RenderScene;
 

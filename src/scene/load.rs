@@ -222,6 +222,7 @@ pub fn appearance(spec: &AppearanceSpec, volume: &Volume, table: Option<&LabelTa
         iso_value: spec.iso.unwrap_or((volume.stats.min + volume.stats.max) * 0.5),
         context: spec.context.validated()?,
         segmentation: None,
+        selection: None,
     })
 }
 

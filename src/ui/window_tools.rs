@@ -307,7 +307,8 @@ mod tests {
         let mut t = Transform::from_scale(Vec3::splat(2.0));
         place_window(&mut w, &mut t, target, Some(Vec3::splat(40.0)), Some(parent));
         let Attachment::User { offset } = w.attachment else { panic!("the attachment changed") };
-        assert!(parent.transform_point(offset.translation).distance(target) < 1e-3);
+        let miss = parent.transform_point(offset.translation).distance(target);
+        assert!(miss < 1e-3, "{miss}: {parent:?} {offset:?}");
         // The size is the world size over the transform's scale.
         assert_eq!(w.size, Vec3::splat(20.0));
     }
