@@ -14,6 +14,8 @@ mod clip;
 mod common;
 #[path = "gpu/context.rs"]
 mod context;
+#[path = "gpu/explode.rs"]
+mod explode;
 #[path = "gpu/lenses.rs"]
 mod lenses;
 #[path = "gpu/twolevel.rs"]
@@ -48,7 +50,8 @@ impl Gpu {
         let meshes: Vec<Entity> = world.query_filtered::<Entity, With<Mesh3d>>().iter(world).collect();
         let windows: Vec<Entity> = world.query_filtered::<Entity, With<focal::windows::VolumeWindow>>().iter(world).collect();
         let sources: Vec<Entity> = world.query_filtered::<Entity, With<focal::windows::SourceBox>>().iter(world).collect();
-        for e in datasets.into_iter().chain(meshes).chain(windows).chain(sources) {
+        let parts: Vec<Entity> = world.query_filtered::<Entity, With<focal::explode::Part>>().iter(world).collect();
+        for e in datasets.into_iter().chain(meshes).chain(windows).chain(sources).chain(parts) {
             world.despawn(e);
         }
         self.off.set_view(VolumeView { jitter: false, ..Default::default() });
@@ -334,7 +337,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [(&str, fn(&mut Gpu)); 21] = [
+    let tests: [(&str, fn(&mut Gpu)); 22] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -356,6 +359,7 @@ fn main() {
         ("overlapping_two_level_regions_match_the_reference", twolevel::overlapping_two_level_regions_match_the_reference),
         ("a_clip_window_shows_nothing_of_the_main_view_inside", windows::a_clip_window_shows_nothing_of_the_main_view_inside),
         ("a_magnifying_window_enlarges_its_source", windows::a_magnifying_window_enlarges_its_source),
+        ("an_exploded_head_matches_the_reference", explode::an_exploded_head_matches_the_reference),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

@@ -36,7 +36,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 12] = [
+const DEFS: [&str; 13] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -49,16 +49,16 @@ const DEFS: [&str; 12] = [
     "HAS_TWO_LEVEL",
     "DVR_PAIRS",
     "LENS_ANTIALIAS",
+    "HAS_SELECTION",
 ];
 
 #[test]
 fn every_shader_variant_composes_and_validates() {
     let bit = |name: &str| 1u32 << DEFS.iter().position(|d| *d == name).unwrap();
     // Every combination the renderer can ask for: anti-aliasing only with lenses, DVR
-    // pairs only with DVR.
-    let possible = |bits: u32| {
-        (bits & bit("LENS_ANTIALIAS") == 0 || bits & bit("HAS_LENSES") != 0) && (bits & bit("DVR_PAIRS") == 0 || bits & bit("HAS_DVR") != 0)
-    };
+    // pairs and selection weights only with DVR.
+    let needs = |a: &str, b: &str, bits: u32| bits & bit(a) == 0 || bits & bit(b) != 0;
+    let possible = |bits: u32| needs("LENS_ANTIALIAS", "HAS_LENSES", bits) && needs("DVR_PAIRS", "HAS_DVR", bits) && needs("HAS_SELECTION", "HAS_DVR", bits);
     for bits in (0u32..(1 << DEFS.len())).filter(|b| possible(*b)) {
         let defs: HashMap<String, ShaderDefValue> = DEFS
             .iter()

@@ -92,6 +92,9 @@ const REGION_SHADING: u32 = 2u;
 const REGION_OCCUPANCY: u32 = 4u;
 // The transfer function has λt, λs channels (after the colours in the LUT atlas).
 const REGION_LAMBDA: u32 = 8u;
+// Opacity weighted by a selection (record: objects.w); KEEP_UNSELECTED: by 1 − doi.
+const REGION_SELECTION: u32 = 16u;
+const REGION_KEEP_UNSELECTED: u32 = 32u;
 
 const VIEW_JITTER: u32 = 1u;
 const VIEW_SKIP_EMPTY: u32 = 2u;

@@ -65,12 +65,14 @@ impl RenderScene {
 
 impl RenderScene {
     /// Every volume the scene samples: its volumes, then the label volumes of
-    /// segmentations that are not among them (the GPU atlas holds all of these).
+    /// segmentations and the selections of selection weights that are not among them
+    /// (the GPU atlas holds all of these).
     pub fn all_volumes(&self) -> Vec<Arc<Volume>> {
         let mut all = self.volumes.clone();
-        for seg in self.appearances.iter().filter_map(|a| a.segmentation.as_ref()) {
-            if !all.iter().any(|v| Arc::ptr_eq(v, &seg.labels)) {
-                all.push(seg.labels.clone());
+        let extra = self.appearances.iter().flat_map(|a| a.segmentation.as_ref().map(|s| &s.labels).into_iter().chain(a.selection.as_ref().map(|w| &w.volume)));
+        for v in extra {
+            if !all.iter().any(|a| Arc::ptr_eq(a, v)) {
+                all.push(v.clone());
             }
         }
         all

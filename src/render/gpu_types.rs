@@ -38,6 +38,10 @@ pub mod region_flags {
     pub const OCCUPANCY: u32 = 4;
     /// Context-preserving with λt, λs channels: their table follows the colours.
     pub const LAMBDA: u32 = 8;
+    /// Opacity weighted by a selection (its record: `objects.w`).
+    pub const SELECTION: u32 = 16;
+    /// With [`SELECTION`]: weighted by 1 − the degree of interest.
+    pub const KEEP_UNSELECTED: u32 = 32;
 }
 
 /// Scene features: which parts of the shader a scene needs (shader defs).
@@ -59,9 +63,11 @@ pub mod features {
     pub const DVR_PAIRS: u32 = 1024;
     /// The view has lenses with anti-aliasing (a per-view feature, with [`LENSES`]).
     pub const LENS_ANTIALIAS: u32 = 2048;
+    /// Some region's opacity is weighted by a selection (exploded views).
+    pub const SELECTION: u32 = 4096;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 12] = [
+    pub const NAMES: [(u32, &str); 13] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -74,6 +80,7 @@ pub mod features {
         (TWO_LEVEL, "HAS_TWO_LEVEL"),
         (DVR_PAIRS, "DVR_PAIRS"),
         (LENS_ANTIALIAS, "LENS_ANTIALIAS"),
+        (SELECTION, "HAS_SELECTION"),
     ];
 }
 
@@ -138,7 +145,10 @@ pub struct GpuRegion {
     pub bounds: Vec4,
     /// Segmented regions ([`mode::TWO_LEVEL`]): index of the first part record (the
     /// objects, then the rest), the number of parts, and the index of the label
-    /// record (the label volume with, per code, up to four candidate objects + 1).
+    /// record (the label volume with, per code, up to four candidate objects + 1);
+    /// `w`: with [`region_flags::SELECTION`], the index of the selection record (the
+    /// selection volume, its map from the data's voxel index, `lut_a·t + lut_b` the
+    /// degree of interest of a normalised sample `t`).
     pub objects: UVec4,
 }
 

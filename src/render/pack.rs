@@ -132,8 +132,12 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         .iter()
         .map(|p| {
             let mut u = vec![p.region.volume];
-            if let Some(seg) = scene.appearances.get(p.region.appearance).and_then(|a| a.segmentation.as_ref()) {
+            let appearance = scene.appearances.get(p.region.appearance);
+            if let Some(seg) = appearance.and_then(|a| a.segmentation.as_ref()) {
                 u.extend(index_of(&seg.labels));
+            }
+            if let Some(w) = appearance.and_then(|a| a.selection.as_ref()) {
+                u.extend(index_of(&w.volume));
             }
             u
         })
@@ -175,6 +179,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
     }
     let slot_of = |out: &PackedScene, v: usize| out.volumes.iter().position(|&u| u == v);
     let mut segmented = Vec::new();
+    let mut weighted = Vec::new();
     for (p, used) in prepared.iter().zip(&uses) {
         let slots: Option<Vec<usize>> = used.iter().map(|&v| slot_of(&out, v)).collect();
         let Some(slots) = slots else {
@@ -186,15 +191,26 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         let mut region = pack_region(p, &levels, out.brick_atlas.offsets[slots[0]], &mut out);
         if p.objects.is_some() {
             region.mode = mode::TWO_LEVEL;
-            segmented.push((out.regions.len(), p, slots));
+            segmented.push((out.regions.len(), p, slots.clone()));
+        }
+        if let Some(w) = &p.weight {
+            region.flags |= region_flags::SELECTION;
+            if w.weight.keep == crate::region::Keep::Unselected {
+                region.flags |= region_flags::KEEP_UNSELECTED;
+            }
+            weighted.push((out.regions.len(), p, slots.last().copied().unwrap_or(slots[0])));
         }
         out.regions.push(region);
     }
     out.region_count = out.regions.len() as u32;
-    // Records the ray does not traverse: the parts and labels of segmented regions.
+    // Records the ray does not traverse: the parts and labels of segmented regions, the
+    // selections of weighted ones.
     for (index, p, slots) in segmented {
         let objects = pack_objects(p, &slots, &mut out);
         out.regions[index].objects = objects;
+    }
+    for (index, p, slot) in weighted {
+        out.regions[index].objects.w = pack_selection(p, slot, &mut out);
     }
     out.features = scene_features(&out.regions, overlaps(&prepared));
     out.max_steps = march_bound(&out.regions[..out.region_count as usize], union_extent(&prepared));
@@ -248,6 +264,31 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
         ..Default::default()
     });
     UVec4::new(first, objects.parts.len() as u32, out.regions.len() as u32 - 1, 0)
+}
+
+/// Appends the selection record of a weighted region (the selection volume in atlas
+/// slot `slot`, mapped from the data's voxel index) and returns its index; one record
+/// per selection volume and data grid is shared by all the regions that use it.
+fn pack_selection(p: &PreparedRegion, slot: usize, out: &mut PackedScene) -> u32 {
+    let Some(w) = &p.weight else { return 0 };
+    let volume = &w.weight.volume;
+    let map = Mat4::from(w.data_to_selection);
+    let (a, b) = ((volume.values.slope * volume.code_max() as f64) as f32, volume.values.intercept as f32);
+    let record = GpuRegion {
+        world_to_voxel: map,
+        dims: volume.dims().as_vec3().extend(volume.code_max() as f32),
+        atlas_offset: out.levels[slot][0].as_vec3().extend(0.0),
+        mode: mode::OFF,
+        lut_a: a,
+        lut_b: b,
+        ..Default::default()
+    };
+    let first = out.region_count as usize;
+    if let Some(i) = out.regions[first..].iter().position(|r| *r == record) {
+        return (first + i) as u32;
+    }
+    out.regions.push(record);
+    out.regions.len() as u32 - 1
 }
 
 /// Most iterations any loop of the ray caster can make on one ray through `regions`:
@@ -378,6 +419,10 @@ pub fn scene_features(regions: &[GpuRegion], overlaps: Overlaps) -> u32 {
         }
         if r.flags & region_flags::SHADING != 0 {
             bits |= f::SHADING;
+        }
+        // (Weights act on DVR samples only: with DVR in the shader.)
+        if r.flags & region_flags::SELECTION != 0 && bits & f::DVR != 0 {
+            bits |= f::SELECTION;
         }
     }
     bits
