@@ -232,3 +232,76 @@ fn at_rest_the_exploded_dataset_looks_as_before_and_exploded_its_selection_stays
     // the axes): its ray meets less of them than it met of the whole head.
     assert!(p.alpha[centre] < 0.5 * a.alpha[centre], "{} vs {}", p.alpha[centre], a.alpha[centre]);
 }
+
+#[test]
+fn scene_files_explode_datasets() {
+    use focal::scene::file::SceneFile;
+    use focal::scene::load::{apply, load_datasets};
+    let text = r#"(
+        datasets: [
+            (source: Phantom(kind: head, resolution: 32), explode: Some((
+                selection: Labels(dataset: 1, ids: [7]), parts: Grid((2, 1, 2)), fixed: [3], degree: 0.5,
+            ))),
+            (source: PhantomLabels(resolution: 32), appearance: (labels: Some(())), visible: false),
+        ],
+        frames: [(name: "up", set: [Explode(dataset: 0, degree: Some(2.0), viewing: Some(true))], settle: Some(100))],
+    )"#;
+    let mut scene = SceneFile::parse(text, "t.ron").unwrap();
+    scene.validate().unwrap();
+    let base = std::path::Path::new(".");
+    let mut datasets = load_datasets(&scene, base).unwrap();
+    let x = datasets[0].explode.as_ref().unwrap();
+    assert_eq!((x.parts.len(), x.fixed.clone(), x.exploded.coefficients.degree), (4, vec![3], 0.5));
+    assert!(x.exploded.selection.as_ref().unwrap().bricks().max.iter().any(|m| *m > 0), "the arteries are selected");
+    let change = scene.frames[0].set[0].clone();
+    apply(&change, &mut datasets, &mut scene, base).unwrap();
+    let x = datasets[0].explode.as_ref().unwrap();
+    assert!(x.exploded.coefficients.degree == 2.0 && x.exploded.viewing);
+    // In an app: the dataset exploded into its parts, the fixed one fixed.
+    let mut app = app();
+    let e = app.world_mut().spawn((datasets[0].component(), Transform::default())).id();
+    focal::explode::spec::replace_explosion(app.world_mut(), e, datasets[0].explode.as_ref());
+    let parts: Vec<Part> = app.world_mut().query::<&Part>().iter(app.world()).cloned().collect();
+    assert_eq!(parts.len(), 4);
+    assert_eq!(parts.iter().filter(|p| p.fixed).count(), 1);
+    // Mistakes name the dataset and the problem.
+    let err = |t: &str| SceneFile::parse(t, "t.ron").and_then(|s| s.validate().map(|_| s)).err().unwrap_or_default();
+    assert!(err("(datasets: [(source: Phantom(kind: head), explode: Some((selection: Labels(dataset: 4, ids: [1]))))])").contains("dataset 0: explode"));
+    assert!(err("(datasets: [(source: Phantom(kind: head), explode: Some((selection: Range(lo: 0.0, hi: 1.0), degre: 1.0)))])").contains("degre"));
+    assert!(err("(datasets: [(source: Phantom(kind: head))], frames: [(name: \"a\", set: [Explode(dataset: 0, degree: Some(1.0))])])").contains("not exploded"));
+}
+
+#[test]
+fn the_viewing_force_clears_the_view_and_follows_the_camera() {
+    use focal::windows::Viewer;
+    let run = |viewing: bool, eyes: &[Vec3]| -> Vec<(f32, f32)> {
+        let mut app = app();
+        let (dataset, parts) = exploded_head(&mut app, 2);
+        let viewer = app.world_mut().spawn((Viewer, Transform::from_translation(eyes[0]))).id();
+        {
+            let mut x = app.world_mut().get_mut::<Exploded>(dataset).unwrap();
+            x.coefficients.degree = 1.0;
+            x.viewing = viewing;
+        }
+        let mut out = Vec::new();
+        for eye in eyes {
+            app.world_mut().get_mut::<Transform>(viewer).unwrap().translation = *eye;
+            app.update();
+            // Right after the camera moved, then settled.
+            let before = hidden_share(&app, dataset, &parts, *eye);
+            step(app.world_mut(), 800);
+            out.push((before, hidden_share(&app, dataset, &parts, *eye)));
+        }
+        out
+    };
+    let eyes = [Vec3::new(40.0, 600.0, 90.0), Vec3::new(600.0, 60.0, -120.0)];
+    let plain = run(false, &eyes);
+    let viewed = run(true, &eyes);
+    // From the first eye the viewing force hides less of the selection than the
+    // explosion alone.
+    assert!(viewed[0].1 < plain[0].1, "{viewed:?} vs {plain:?}");
+    // The camera turns: the parts, arranged for the old view, hide the selection from
+    // the new one; the viewing force moves them off its rays again.
+    assert!(viewed[1].1 < viewed[1].0, "after turning: {:?}", viewed[1]);
+    assert!(viewed[1].1 < plain[1].1, "{viewed:?} vs {plain:?}");
+}

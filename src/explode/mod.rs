@@ -20,6 +20,7 @@ pub mod forces;
 pub mod parts;
 pub mod points;
 pub mod regions;
+pub mod spec;
 pub mod splitters;
 pub mod systems;
 

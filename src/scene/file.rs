@@ -143,6 +143,9 @@ pub struct DatasetSpec {
     /// Clip planes and box, in the dataset's frame (mm).
     #[serde(default, skip_serializing_if = "is_unclipped")]
     pub clip: Clipping,
+    /// An exploded view of this dataset ([`crate::explode::spec`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub explode: Option<crate::explode::spec::ExplodeSpec>,
 }
 
 impl DatasetSpec {
@@ -156,6 +159,7 @@ impl DatasetSpec {
             rotation_deg: (0.0, 0.0, 0.0),
             visible: true,
             clip: Clipping::default(),
+            explode: None,
         }
     }
 }
@@ -346,7 +350,15 @@ pub struct FrameSpec {
     pub camera: Option<CameraSpec>,
     #[serde(default)]
     pub set: Vec<Change>,
+    /// Physics steps of exploded views before the capture (1/120 s each; default
+    /// [`SETTLE_STEPS`] when a dataset is exploded).
+    #[serde(default)]
+    pub settle: Option<u32>,
 }
+
+/// Physics steps before a frame of an exploded view is captured: 5 s, enough for the
+/// parts to come to rest.
+pub const SETTLE_STEPS: u32 = 600;
 
 /// A parameter change between frames. `dataset` is the index in `datasets`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -414,6 +426,16 @@ pub enum Change {
     Pointer(Option<(f32, f32, f32)>),
     /// Replaces the rendering switches.
     Rendering(RenderingSpec),
+    /// The exploded view of a dataset: degree of explosion, viewing force, δ.
+    Explode {
+        dataset: usize,
+        #[serde(default)]
+        degree: Option<f32>,
+        #[serde(default)]
+        viewing: Option<bool>,
+        #[serde(default)]
+        deltas: Option<(f32, f32, f32)>,
+    },
 }
 
 impl SceneFile {
@@ -425,6 +447,11 @@ impl SceneFile {
     /// Checks what parsing cannot: the lenses' parameters.
     pub fn validate(&self) -> Result<(), String> {
         validate_lenses(&self.lenses)?;
+        for (i, d) in self.datasets.iter().enumerate() {
+            if let Some(x) = &d.explode {
+                x.validate(self.datasets.len()).map_err(|e| format!("dataset {i}: explode: {e}"))?;
+            }
+        }
         self.validate_windows(&self.windows)?;
         self.markers.iter().enumerate().try_for_each(|(i, m)| m.validate(i, self.datasets.len()))?;
         for frame in &self.frames {
@@ -432,10 +459,24 @@ impl SceneFile {
                 let checked = match change {
                     Change::Lenses(lenses) => validate_lenses(lenses),
                     Change::Windows(windows) => self.validate_windows(windows),
+                    Change::Explode { dataset, degree, deltas, .. } => self.validate_explode_change(*dataset, *degree, *deltas),
                     _ => Ok(()),
                 };
                 checked.map_err(|e| format!("frame '{}': {e}", frame.name))?;
             }
+        }
+        Ok(())
+    }
+
+    fn validate_explode_change(&self, dataset: usize, degree: Option<f32>, deltas: Option<(f32, f32, f32)>) -> Result<(), String> {
+        match self.datasets.get(dataset) {
+            None => return Err(format!("Explode refers to dataset {dataset}, the scene has {}", self.datasets.len())),
+            Some(d) if d.explode.is_none() => return Err(format!("Explode: dataset {dataset} is not exploded (it has no explode)")),
+            _ => {}
+        }
+        let values = degree.into_iter().chain(deltas.into_iter().flat_map(|(a, b, c)| [a, b, c]));
+        if values.into_iter().any(|v| !v.is_finite() || v < 0.0) {
+            return Err("Explode: the degree and deltas must be finite and not negative".into());
         }
         Ok(())
     }

@@ -27,6 +27,8 @@ pub struct LoadedDataset {
     pub visible: bool,
     pub clip: Clipping,
     pub spec: DatasetSpec,
+    /// Its exploded view, loaded.
+    pub explode: Option<crate::explode::spec::LoadedExplode>,
 }
 
 impl LoadedDataset {
@@ -69,14 +71,31 @@ pub fn load_datasets_with(scene: &SceneFile, base: &Path, progress: Option<Progr
         .enumerate()
         .map(|(i, d)| load_dataset(d, base, &options).map_err(|e| format!("dataset {i}: {e}")))
         .collect::<Result<_, _>>()?;
-    // Segmentations refer to other datasets: resolved once all are loaded.
+    // Segmentations and exploded views refer to other datasets: resolved once all are
+    // loaded.
     for i in 0..datasets.len() {
         if let Some(spec) = &scene.datasets[i].appearance.segmentation {
             let seg = segmentation(spec, &datasets, &datasets[i].volume, base).map_err(|e| format!("dataset {i}: segmentation: {e}"))?;
             datasets[i].appearance.segmentation = Some(seg);
         }
+        if let Some(spec) = &scene.datasets[i].explode {
+            let x = explosion(spec, &datasets, i, base).map_err(|e| format!("dataset {i}: explode: {e}"))?;
+            datasets[i].explode = Some(x);
+        }
     }
     Ok(datasets)
+}
+
+/// The exploded view a spec describes for dataset `i`.
+pub fn explosion(spec: &crate::explode::spec::ExplodeSpec, datasets: &[LoadedDataset], i: usize, base: &Path) -> Result<crate::explode::spec::LoadedExplode, String> {
+    let data = &datasets[i].volume;
+    let label = |d: usize| {
+        let ds = datasets.get(d)?;
+        Some(LabelVolume { volume: (*ds.volume).clone(), table: ds.table.clone()? })
+    };
+    let selection = spec.selection(data, label)?;
+    let look = spec.look.as_ref().map(|l| appearance(l, data, None, base)).transpose().map_err(|e| format!("look: {e}"))?;
+    Ok(crate::explode::spec::LoadedExplode { exploded: spec.exploded(selection, look), parts: spec.parts(data)?, fixed: spec.fixed.clone() })
 }
 
 /// The segmentation a spec describes for data volume `data`.
@@ -178,6 +197,7 @@ fn dataset(spec: &DatasetSpec, volume: Volume, appearance: Appearance, table: Op
         visible: spec.visible,
         clip: spec.clip.clone().validated()?,
         spec: spec.clone(),
+        explode: None,
     })
 }
 
@@ -330,6 +350,19 @@ pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneF
         Change::Windows(w) => scene.windows = w.clone(),
         Change::Pointer(p) => scene.pointer = *p,
         Change::Rendering(r) => scene.rendering = *r,
+        Change::Explode { dataset, degree, viewing, deltas } => {
+            let x = datasets[get(*dataset)?].explode.as_mut().ok_or_else(|| format!("Explode: dataset {dataset} is not exploded"))?;
+            let c = &mut x.exploded.coefficients;
+            if let Some(d) = degree {
+                c.degree = *d;
+            }
+            if let Some((e, v, s)) = deltas {
+                (c.delta_explosion, c.delta_viewing, c.delta_spacing) = (*e, *v, *s);
+            }
+            if let Some(v) = viewing {
+                x.exploded.viewing = *v;
+            }
+        }
     }
     Ok(())
 }

@@ -27,7 +27,7 @@ pub struct RunOptions {
 
 /// The frames to capture (one "default" frame when the file lists none).
 fn frames(scene: &SceneFile) -> Vec<FrameSpec> {
-    if scene.frames.is_empty() { vec![FrameSpec { name: "default".into(), camera: None, set: Vec::new() }] } else { scene.frames.clone() }
+    if scene.frames.is_empty() { vec![FrameSpec { name: "default".into(), camera: None, set: Vec::new(), settle: None }] } else { scene.frames.clone() }
 }
 
 /// A file-name-safe version of a frame name.
@@ -71,8 +71,11 @@ pub fn render_frames(mut scene: SceneFile, base: &Path, options: &RunOptions) ->
             bounds = visible_bounds(&datasets);
         }
         let cam = camera(&camera_spec, bounds, w as f32 / h as f32);
+        let exploded = datasets.iter().any(|d| d.explode.is_some());
+        let settle = frame.settle.unwrap_or(if exploded { crate::scene::file::SETTLE_STEPS } else { 0 });
         let image = match &mut gpu {
-            Some(g) => g.capture(&datasets, &scene, &cam, base)?,
+            Some(g) => g.capture(&datasets, &scene, &cam, base, settle)?,
+            None if exploded => return Err("exploded views are simulated in the app: render this scene without --cpu".into()),
             None => render_lensed(&render_scene_with_windows(&datasets, &scene, &cam, base)?, &cam, &scene.lenses, w, h)?.to_image()?,
         };
         images.push((frame.name.clone(), image));
@@ -91,7 +94,13 @@ impl GpuRun {
         let mut off = Offscreen::new(w, h, |app| {
             app.add_plugins((FocalPlugins, crate::windows::frames::WindowFramePlugin));
         })?;
-        let entities = datasets.iter().map(|d| off.world_mut().spawn((dataset_component(d), transform(d))).id()).collect();
+        let entities: Vec<Entity> = datasets.iter().map(|d| off.world_mut().spawn((dataset_component(d), transform(d))).id()).collect();
+        for (e, d) in entities.iter().zip(datasets) {
+            crate::explode::spec::replace_explosion(off.world_mut(), *e, d.explode.as_ref());
+        }
+        // The camera is the viewer (user-attached windows, the viewing force).
+        let camera = off.camera();
+        off.world_mut().entity_mut(camera).insert(crate::windows::Viewer);
         Ok(GpuRun { off, entities })
     }
 
@@ -101,9 +110,19 @@ impl GpuRun {
         scene: &SceneFile,
         cam: &crate::region::Camera,
         base: &Path,
+        settle: u32,
     ) -> Result<image::RgbaImage, String> {
         for (e, d) in self.entities.iter().zip(datasets) {
             self.off.world_mut().entity_mut(*e).insert((dataset_component(d), transform(d)));
+            // The parts stay where the last frame left them; the coefficients follow
+            // the frame's changes.
+            if let Some(x) = &d.explode
+                && let Some(mut now) = self.off.world_mut().get_mut::<crate::explode::Exploded>(*e)
+                && (now.coefficients != x.exploded.coefficients || now.viewing != x.exploded.viewing)
+            {
+                now.coefficients = x.exploded.coefficients;
+                now.viewing = x.exploded.viewing;
+            }
         }
         self.off.world_mut().insert_resource(SceneLight(scene.light));
         replace_lenses(self.off.world_mut(), &scene.lenses);
@@ -122,6 +141,12 @@ impl GpuRun {
         });
         self.off.set_background(scene.background());
         self.off.set_camera(cam);
+        if settle > 0 {
+            // One update first: the camera (the viewing force's eye), the explosion
+            // points and the bodies are in place before the steps.
+            self.off.update();
+            crate::explode::step(self.off.world_mut(), settle);
+        }
         self.off.capture()
     }
 }

@@ -126,6 +126,8 @@ pub fn scene_file(
                 rotation_deg: (x.to_degrees(), y.to_degrees(), z.to_degrees()),
                 visible: d.visible,
                 clip: d.clip.clone(),
+                // (The app does not edit exploded views yet: what was loaded.)
+                explode: d.spec.explode.clone(),
             }
         })
         .collect();
