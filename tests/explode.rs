@@ -12,6 +12,9 @@ use focal::transfer::presets;
 use focal::volume::phantom::Phantom;
 use focal::volume::{SelectionVolume, Volume};
 
+#[path = "explode/joints.rs"]
+mod joints;
+
 fn app() -> App {
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, TransformPlugin, FocalCorePlugins));
@@ -241,6 +244,8 @@ fn scene_files_explode_datasets() {
         datasets: [
             (source: Phantom(kind: head, resolution: 32), explode: Some((
                 selection: Labels(dataset: 1, ids: [7]), parts: Grid((2, 1, 2)), fixed: [3], degree: 0.5,
+                groups: [[1, 2]], hidden: [0],
+                joints: [(kind: hinge, part: 0, anchor: (0.0, 0.0, 0.0), axis: (0.0, 0.0, 1.0))],
             ))),
             (source: PhantomLabels(resolution: 32), appearance: (labels: Some(())), visible: false),
         ],
@@ -251,7 +256,7 @@ fn scene_files_explode_datasets() {
     let base = std::path::Path::new(".");
     let mut datasets = load_datasets(&scene, base).unwrap();
     let x = datasets[0].explode.as_ref().unwrap();
-    assert_eq!((x.parts.len(), x.fixed.clone(), x.exploded.coefficients.degree), (4, vec![3], 0.5));
+    assert_eq!((x.parts.len(), x.spec.fixed.clone(), x.exploded.coefficients.degree), (4, vec![3], 0.5));
     assert!(x.exploded.selection.as_ref().unwrap().bricks().max.iter().any(|m| *m > 0), "the arteries are selected");
     let change = scene.frames[0].set[0].clone();
     apply(&change, &mut datasets, &mut scene, base).unwrap();
@@ -264,6 +269,11 @@ fn scene_files_explode_datasets() {
     let parts: Vec<Part> = app.world_mut().query::<&Part>().iter(app.world()).cloned().collect();
     assert_eq!(parts.len(), 4);
     assert_eq!(parts.iter().filter(|p| p.fixed).count(), 1);
+    assert_eq!(parts.iter().filter(|p| p.hidden).count(), 1);
+    assert_eq!(parts.iter().filter(|p| p.group == Some(0)).count(), 2);
+    let joints: Vec<focal::explode::PartJoint> = app.world_mut().query::<&focal::explode::PartJoint>().iter(app.world()).cloned().collect();
+    assert_eq!(joints.len(), 1);
+    assert!(joints[0].kind == focal::explode::JointKind::Hinge && joints[0].to.is_none());
     // Mistakes name the dataset and the problem.
     let err = |t: &str| SceneFile::parse(t, "t.ron").and_then(|s| s.validate().map(|_| s)).err().unwrap_or_default();
     assert!(err("(datasets: [(source: Phantom(kind: head), explode: Some((selection: Labels(dataset: 4, ids: [1]))))])").contains("dataset 0: explode"));

@@ -10,13 +10,16 @@
 //!
 //! - [`points`]: explosion points from the data's and the selection's min-max octrees;
 //! - [`regions`]: parts as regions of the ray caster;
-//! - [`components`], [`systems`]: parts as rapier rigid bodies, the forces of each step.
+//! - [`components`], [`systems`]: parts as rapier rigid bodies, the forces of each step;
+//! - [`joints`]: slider, hinge, ball, universal and fixed joints (section 3.3), groups;
+//! - [`spec`]: exploded views in scene files.
 //!
 //! The math modules are pure (glam only) and unit-tested against values worked out by
 //! hand.
 
 pub mod components;
 pub mod forces;
+pub mod joints;
 pub mod parts;
 pub mod points;
 pub mod regions;
@@ -25,4 +28,5 @@ pub mod splitters;
 pub mod systems;
 
 pub use components::{ExplodeTiming, Exploded, ExplosionPoints, Part};
+pub use joints::{JointKind, PartJoint};
 pub use systems::{ExplodePlugin, ExplodeStep, step};

@@ -9,6 +9,9 @@
 //!     degree: 1.0, viewing: true, deltas: (0.5, 0.333, 0.1667),
 //!     parts: Grid((2, 1, 2)),                        // or Planes([...]), Parts([[...], ...])
 //!     fixed: [0],
+//!     hidden: [3], groups: [[1, 2]], density: [(0, 4.0)],
+//!     joints: [(kind: hinge, part: 1, to: None, anchor: (0.0, 60.0, 0.0), axis: (0.0, 0.0, 1.0),
+//!               limits: Some((0.0, 90.0)))],
 //! )),
 //! ```
 //!
@@ -16,7 +19,11 @@
 //! `Planes` cuts every part a plane crosses, one plane after another (dataset frame, a
 //! plane keeps `normal · p ≤ offset` on its first side); `Parts` lists each part's
 //! planes (what the app saves). `fixed` lists parts (in the order the cuts give) that do
-//! not move.
+//! not move, `hidden` those that draw nothing, `groups` parts that move as one,
+//! `density` parts heavier or lighter than the default (1). Joints ([`super::joints`])
+//! tie a part to another (`to: Some(index)`) or to the world (`to: None`); anchor and axes
+//! at rest in the dataset's frame (mm), limits in degrees (mm for sliders), `axis2` the
+//! universal joint's second axis.
 
 use std::collections::BTreeSet;
 use std::sync::Arc;
@@ -26,6 +33,7 @@ use serde::{Deserialize, Serialize};
 
 use super::components::{Exploded, Part};
 use super::forces::Coefficients;
+use super::joints::{JointKind, PartJoint};
 use super::parts::Polyhedron;
 use super::systems::{spawn_part, volume_polyhedron};
 use crate::region::{Appearance, Plane};
@@ -54,6 +62,89 @@ pub struct ExplodeSpec {
     pub parts: PartsSpec,
     #[serde(default)]
     pub fixed: Vec<usize>,
+    #[serde(default)]
+    pub hidden: Vec<usize>,
+    #[serde(default)]
+    pub groups: Vec<Vec<usize>>,
+    /// (part, density relative to the default).
+    #[serde(default)]
+    pub density: Vec<(usize, f32)>,
+    #[serde(default)]
+    pub joints: Vec<JointSpec>,
+}
+
+/// A joint in a scene file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec {
+    pub kind: JointKind,
+    pub part: usize,
+    /// The other part (`None`: the world).
+    #[serde(default)]
+    pub to: Option<usize>,
+    pub anchor: (f32, f32, f32),
+    #[serde(default = "x_axis")]
+    pub axis: (f32, f32, f32),
+    #[serde(default)]
+    pub axis2: Option<(f32, f32, f32)>,
+    #[serde(default)]
+    pub limits: Option<(f32, f32)>,
+}
+
+fn x_axis() -> (f32, f32, f32) {
+    (1.0, 0.0, 0.0)
+}
+
+fn vec3(t: (f32, f32, f32)) -> Vec3 {
+    Vec3::new(t.0, t.1, t.2)
+}
+
+fn tuple(v: Vec3) -> (f32, f32, f32) {
+    (v.x, v.y, v.z)
+}
+
+impl JointSpec {
+    /// The joint, with `part(i)` the entity of part `i`.
+    pub fn joint(&self, part: impl Fn(usize) -> Entity) -> PartJoint {
+        let mut j = PartJoint::new(self.kind, part(self.part), self.to.map(&part), vec3(self.anchor), vec3(self.axis));
+        if let Some(a) = self.axis2 {
+            j.axis2 = vec3(a);
+        }
+        j.limits = self.limits;
+        j
+    }
+
+    /// The spec of `joint`, with `index(e)` the index of part entity `e`.
+    pub fn of(joint: &PartJoint, index: impl Fn(Entity) -> Option<usize>) -> Option<JointSpec> {
+        Some(JointSpec {
+            kind: joint.kind,
+            part: index(joint.part)?,
+            to: match joint.to {
+                Some(t) => Some(index(t)?),
+                None => None,
+            },
+            anchor: tuple(joint.anchor),
+            axis: tuple(joint.axis),
+            axis2: (joint.kind == JointKind::Universal).then(|| tuple(joint.axis2)),
+            limits: joint.limits,
+        })
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        let finite = |t: (f32, f32, f32)| vec3(t).is_finite();
+        if !finite(self.anchor) || !finite(self.axis) || vec3(self.axis).length() < 1e-9 || self.axis2.is_some_and(|a| !finite(a)) {
+            return Err("the anchor and axes must be finite, the axis not zero".into());
+        }
+        if self.to == Some(self.part) {
+            return Err(format!("part {} is joined to itself", self.part));
+        }
+        if let Some((lo, hi)) = self.limits
+            && !(lo.is_finite() && hi.is_finite())
+        {
+            return Err(format!("limits {lo}..{hi} must be finite"));
+        }
+        Ok(())
+    }
 }
 
 fn default_deltas() -> (f32, f32, f32) {
@@ -131,6 +222,12 @@ impl ExplodeSpec {
         if self.smooth > 16 {
             return Err(format!("{} smoothing passes, at most 16", self.smooth));
         }
+        for (i, j) in self.joints.iter().enumerate() {
+            j.validate().map_err(|e| format!("joint {i}: {e}"))?;
+        }
+        if let Some((i, d)) = self.density.iter().find(|(_, d)| !(d.is_finite() && *d > 0.0)) {
+            return Err(format!("part {i}: density {d} must be finite and above 0 (fixed parts are listed in fixed)"));
+        }
         let plane_ok = |p: &PlaneSpec| {
             let n = Vec3::new(p.normal.0, p.normal.1, p.normal.2);
             n.is_finite() && n.length() > 1e-9 && p.offset.is_finite()
@@ -184,8 +281,18 @@ impl ExplodeSpec {
                 })
                 .collect::<Result<_, _>>()?,
         };
-        if let Some(bad) = self.fixed.iter().find(|&&i| i >= parts.len()) {
-            return Err(format!("fixed part {bad}: the cuts give {} parts", parts.len()));
+        let n = parts.len();
+        let listed = [
+            ("fixed", self.fixed.clone()),
+            ("hidden", self.hidden.clone()),
+            ("grouped", self.groups.concat()),
+            ("density of", self.density.iter().map(|d| d.0).collect()),
+            ("jointed", self.joints.iter().flat_map(|j| std::iter::once(j.part).chain(j.to)).collect()),
+        ];
+        for (what, indices) in listed {
+            if let Some(bad) = indices.iter().find(|&&i| i >= n) {
+                return Err(format!("{what} part {bad}: the cuts give {n} parts"));
+            }
         }
         Ok(parts)
     }
@@ -237,7 +344,8 @@ fn has_selected(sel: &SelectionVolume) -> bool {
 pub struct LoadedExplode {
     pub exploded: Exploded,
     pub parts: Vec<Polyhedron>,
-    pub fixed: Vec<usize>,
+    /// Fixed, hidden, groups, densities and joints, by part index.
+    pub spec: ExplodeSpec,
 }
 
 impl std::fmt::Debug for LoadedExplode {
@@ -245,7 +353,8 @@ impl std::fmt::Debug for LoadedExplode {
         f.debug_struct("LoadedExplode")
             .field("coefficients", &self.exploded.coefficients)
             .field("parts", &self.parts.len())
-            .field("fixed", &self.fixed)
+            .field("fixed", &self.spec.fixed)
+            .field("joints", &self.spec.joints.len())
             .finish()
     }
 }
@@ -262,9 +371,25 @@ pub fn replace_explosion(world: &mut World, dataset: Entity, loaded: Option<&Loa
         return;
     };
     world.entity_mut(dataset).insert(loaded.exploded.clone());
-    for (i, rest) in loaded.parts.iter().enumerate() {
-        let part = Part { fixed: loaded.fixed.contains(&i), ..Part::new(dataset, rest.clone()) };
-        spawn_part(world, part, Transform::default());
+    let spec = &loaded.spec;
+    let group = |i: usize| spec.groups.iter().position(|g| g.contains(&i)).map(|g| g as u32);
+    let entities: Vec<Entity> = loaded
+        .parts
+        .iter()
+        .enumerate()
+        .map(|(i, rest)| {
+            let part = Part {
+                fixed: spec.fixed.contains(&i),
+                hidden: spec.hidden.contains(&i),
+                group: group(i),
+                density: spec.density.iter().find(|d| d.0 == i).map_or(1.0, |d| d.1),
+                ..Part::new(dataset, rest.clone())
+            };
+            spawn_part(world, part, Transform::default())
+        })
+        .collect();
+    for j in &spec.joints {
+        world.spawn(j.joint(|i| entities.get(i).copied().unwrap_or(Entity::PLACEHOLDER)));
     }
 }
 
@@ -308,5 +433,20 @@ mod tests {
         )
         .unwrap();
         assert_eq!(planes.parts(&head).unwrap().len(), 4);
+        // Joints, groups and densities: checked, and their part indices against the cuts.
+        let layout = |tail: &str| ron::from_str::<ExplodeSpec>(&format!("(selection: Range(lo: 300.0, hi: 4000.0), parts: Grid((2, 1, 2)), {tail})"));
+        let ok = layout("groups: [[0, 1]], density: [(2, 3.0)], joints: [(kind: hinge, part: 3, to: Some(2), anchor: (0.0, 0.0, 0.0), axis: (0.0, 0.0, 1.0), limits: Some((0.0, 90.0)))]").unwrap();
+        ok.validate(1).unwrap();
+        assert_eq!(ok.parts(&head).unwrap().len(), 4);
+        let j = ok.joints[0].joint(|i| Entity::from_raw_u32(i as u32 + 10).unwrap());
+        assert_eq!((j.kind, j.part.index_u32(), j.to.map(|e| e.index_u32()), j.limits), (JointKind::Hinge, 13, Some(12), Some((0.0, 90.0))));
+        assert_eq!(JointSpec::of(&j, |e| Some(e.index_u32() as usize - 10)).as_ref(), Some(&ok.joints[0]), "saved as loaded");
+        let e = |tail: &str| layout(tail).map_err(|e| e.to_string()).and_then(|s| s.validate(1).and_then(|_| s.parts(&head).map(|_| ()))).unwrap_err();
+        assert!(e("joints: [(kind: slider, part: 9, anchor: (0.0, 0.0, 0.0))]").contains("jointed part 9"));
+        assert!(e("joints: [(kind: ball, part: 1, to: Some(1), anchor: (0.0, 0.0, 0.0))]").contains("joint 0: part 1 is joined to itself"));
+        assert!(e("joints: [(kind: hinge, part: 1, anchor: (0.0, 0.0, 0.0), axis: (0.0, 0.0, 0.0))]").contains("joint 0"));
+        assert!(e("joints: [(kind: hing, part: 1, anchor: (0.0, 0.0, 0.0))]").contains("hing"), "a typo of the kind");
+        assert!(e("density: [(1, 0.0)]").contains("density"));
+        assert!(e("groups: [[1, 4]]").contains("grouped part 4"));
     }
 }

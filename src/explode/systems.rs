@@ -14,6 +14,7 @@ use bevy_rapier3d::rapier::dynamics::IntegrationParameters;
 
 use super::components::{ExplodeTiming, Exploded, ExplosionPoints, Part};
 use super::forces::{PartNow, Scale, Surroundings, part_wrench};
+use super::joints::{build_joints, group_joints};
 use super::parts::Polyhedron;
 use super::points::explosion_points;
 use super::regions::{PlacedPart, part_regions};
@@ -41,7 +42,7 @@ impl Plugin for ExplodePlugin {
             .insert_resource(TimestepMode::Fixed { dt: 1.0 / timing.steps_per_second, substeps: 1 })
             .insert_resource(timing)
             .add_systems(ExplodeStep, apply_forces.before(PhysicsSet::SyncBackend))
-            .add_systems(Update, (ensure_parts, update_points, sync_bodies).chain())
+            .add_systems(Update, (ensure_parts, group_joints, build_joints, update_points, sync_bodies).chain())
             .add_systems(PostUpdate, exploded_regions.in_set(RegionSystems::Modify).before(crate::windows::systems::window_regions));
     }
 }
@@ -255,7 +256,7 @@ pub fn exploded_regions(
             Some((region, volume, e))
         })
         .collect();
-    targets.sort_by(|a, b| b.0.cmp(&a.0));
+    targets.sort_by_key(|t| std::cmp::Reverse(t.0));
     for (region_index, volume_index, entity) in targets {
         let Ok((_, d, x, gpu, global)) = datasets.get(entity) else { continue };
         if parts.iter().all(|(p, _)| p.dataset != entity) {

@@ -95,7 +95,7 @@ pub fn explosion(spec: &crate::explode::spec::ExplodeSpec, datasets: &[LoadedDat
     };
     let selection = spec.selection(data, label)?;
     let look = spec.look.as_ref().map(|l| appearance(l, data, None, base)).transpose().map_err(|e| format!("look: {e}"))?;
-    Ok(crate::explode::spec::LoadedExplode { exploded: spec.exploded(selection, look), parts: spec.parts(data)?, fixed: spec.fixed.clone() })
+    Ok(crate::explode::spec::LoadedExplode { exploded: spec.exploded(selection, look), parts: spec.parts(data)?, spec: spec.clone() })
 }
 
 /// The segmentation a spec describes for data volume `data`.
