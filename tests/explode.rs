@@ -12,6 +12,8 @@ use focal::transfer::presets;
 use focal::volume::phantom::Phantom;
 use focal::volume::{SelectionVolume, Volume};
 
+#[path = "explode/edit.rs"]
+mod edit;
 #[path = "explode/joints.rs"]
 mod joints;
 

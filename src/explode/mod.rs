@@ -12,12 +12,14 @@
 //! - [`regions`]: parts as regions of the ray caster;
 //! - [`components`], [`systems`]: parts as rapier rigid bodies, the forces of each step;
 //! - [`joints`]: slider, hinge, ball, universal and fixed joints (section 3.3), groups;
-//! - [`spec`]: exploded views in scene files.
+//! - [`spec`]: exploded views in scene files;
+//! - [`edit`]: exploding, the splitters applied to the parts, undo (the app's edits).
 //!
 //! The math modules are pure (glam only) and unit-tested against values worked out by
 //! hand.
 
 pub mod components;
+pub mod edit;
 pub mod forces;
 pub mod joints;
 pub mod parts;

@@ -367,10 +367,10 @@ pub fn replace_explosion(world: &mut World, dataset: Entity, loaded: Option<&Loa
         world.despawn(e);
     }
     let Some(loaded) = loaded else {
-        world.entity_mut(dataset).remove::<(Exploded, super::components::ExplosionPoints)>();
+        world.entity_mut(dataset).remove::<(Exploded, super::components::ExplosionPoints, super::components::ExplodeSource)>();
         return;
     };
-    world.entity_mut(dataset).insert(loaded.exploded.clone());
+    world.entity_mut(dataset).insert((loaded.exploded.clone(), super::components::ExplodeSource(loaded.spec.clone())));
     let spec = &loaded.spec;
     let group = |i: usize| spec.groups.iter().position(|g| g.contains(&i)).map(|g| g as u32);
     let entities: Vec<Entity> = loaded

@@ -42,7 +42,8 @@ impl Plugin for ExplodePlugin {
             .insert_resource(TimestepMode::Fixed { dt: 1.0 / timing.steps_per_second, substeps: 1 })
             .insert_resource(timing)
             .add_systems(ExplodeStep, apply_forces.before(PhysicsSet::SyncBackend))
-            .add_systems(Update, (ensure_parts, group_joints, build_joints, update_points, sync_bodies).chain())
+            .init_resource::<super::edit::ExplodeEdits>()
+            .add_systems(Update, (super::edit::apply_edits, ensure_parts, group_joints, build_joints, update_points, sync_bodies).chain())
             .add_systems(PostUpdate, exploded_regions.in_set(RegionSystems::Modify).before(crate::windows::systems::window_regions));
     }
 }
