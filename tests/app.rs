@@ -105,6 +105,45 @@ fn the_app_opens_a_window_and_shows_the_phantom() {
     assert!(warm > 2000, "only {warm} phantom-coloured pixels");
 }
 
+/// The app's screenshot of `scene` after `frames` frames (in Xvfb).
+fn app_screenshot(scene: &std::path::Path, frames: u32, shot: &std::path::Path) -> image::RgbaImage {
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_focal"))
+        .arg(scene)
+        .args(["--frames", &frames.to_string(), "--window", "800x500", "--screenshot"])
+        .arg(shot)
+        .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    image::open(shot).unwrap().to_rgba8()
+}
+
+#[test]
+fn the_app_simulates_exploded_views_and_opens_their_panel() {
+    let dir = scratch("app-explode");
+    // The head in two halves around the brain, at degree 0 and at degree 6.
+    let scene = |degree: f32| {
+        let text = format!(
+            r#"(datasets: [
+                (source: Phantom(kind: head, resolution: 64), appearance: (mode: dvr, preset: Some("ct_skin_bone")),
+                 explode: Some((selection: Labels(dataset: 1, ids: [4, 5, 6]), parts: Grid((2, 1, 1)), degree: {degree:.1}))),
+                (source: PhantomLabels(resolution: 64), appearance: (labels: Some(())), visible: false),
+            ], camera: View(view: anterior))"#
+        );
+        let path = dir.join(format!("explode_{degree}.ron"));
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let rest = app_screenshot(&scene(0.0), 40, &dir.join("rest.png"));
+    let apart = app_screenshot(&scene(6.0), 40, &dir.join("apart.png"));
+    // The panel opened on its own: the same window in both (its title bar's pixels
+    // differ from the plain app's nowhere else than in the viewport).
+    let differ = rest.pixels().zip(apart.pixels()).filter(|(a, b)| (0..3).any(|c| (a[c] as i32 - b[c] as i32).abs() > 40)).count();
+    assert!(differ > 3000, "the halves moved apart in the app: {differ} pixels differ ({})", dir.display());
+}
+
 fn lenses(world: &mut World) -> Vec<(u32, focal::lens::Lens)> {
     let mut v: Vec<_> =
         world.query::<(&focal::lens::Lens, &focal::lens::systems::LensOrder)>().iter(world).map(|(l, o)| (o.0, l.clone())).collect();

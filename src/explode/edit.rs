@@ -47,6 +47,20 @@ pub enum Edit {
     Split { dataset: Entity, splitter: Splitter },
     /// Puts the last split part of `dataset` back.
     Undo { dataset: Entity },
+    /// Picks the part first hit by `ray` and the point hit ([`ExplodeEdits::picked`]),
+    /// for a joint.
+    Pick { dataset: Entity, ray: Ray },
+}
+
+/// A picked point on a part: the part, the point in the world and in the part's rest
+/// frame (the dataset's frame at rest, where joints are given), and the part's rotation
+/// into the world (to carry world axes into the rest frame).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Picked {
+    pub part: Entity,
+    pub world: Vec3,
+    pub rest: Vec3,
+    pub to_world: Affine3A,
 }
 
 /// Edits waiting for [`apply_edits`], and what the last one said went wrong.
@@ -54,6 +68,7 @@ pub enum Edit {
 pub struct ExplodeEdits {
     pub queue: Vec<Edit>,
     pub error: Option<String>,
+    pub picked: Option<Picked>,
 }
 
 /// One split, to undo it.
@@ -99,6 +114,14 @@ pub fn apply(world: &mut World, edit: Edit) -> Result<(), String> {
         }
         Edit::Split { dataset, splitter } => split(world, dataset, &splitter).map(|_| ()),
         Edit::Undo { dataset } => undo(world, dataset),
+        Edit::Pick { dataset, ray } => {
+            let hit = first_background_hit(world, ray)?.ok_or("no part under the cursor")?;
+            let part = part_at(world, dataset, hit).ok_or("no part under the cursor")?;
+            let motion = world.get::<Transform>(part).map_or(Affine3A::IDENTITY, |t| t.compute_affine());
+            let to_world = dataset_to_world(world, dataset) * motion;
+            world.resource_mut::<ExplodeEdits>().picked = Some(Picked { part, world: hit, rest: to_world.inverse().transform_point3(hit), to_world });
+            Ok(())
+        }
     }
 }
 
@@ -275,18 +298,25 @@ pub fn current_spec(world: &mut World, dataset: Entity) -> Option<ExplodeSpec> {
     let source = world.get::<ExplodeSource>(dataset)?.0.clone();
     let x = world.get::<Exploded>(dataset)?.clone();
     let parts = parts_of(world, dataset);
+    let joints: Vec<PartJoint> = world.query_filtered::<&PartJoint, Without<GroupJoint>>().iter(world).cloned().collect();
+    Some(spec_of(&source, &x, &parts.iter().map(|(e, p, _)| (*e, p)).collect::<Vec<_>>(), &joints))
+}
+
+/// The spec of an exploded view made from `source`, with `parts` (in entity order) and
+/// the `joints` (any dataset's: those of other parts are left out).
+pub fn spec_of(source: &ExplodeSpec, x: &Exploded, parts: &[(Entity, &Part)], joints: &[PartJoint]) -> ExplodeSpec {
     let index = |e: Entity| parts.iter().position(|p| p.0 == e);
-    let flagged = |f: &dyn Fn(&Part) -> bool| parts.iter().enumerate().filter(|(_, p)| f(&p.1)).map(|(i, _)| i).collect::<Vec<_>>();
+    let flagged = |f: &dyn Fn(&Part) -> bool| parts.iter().enumerate().filter(|(_, p)| f(p.1)).map(|(i, _)| i).collect::<Vec<_>>();
     let mut groups: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
     for (i, p) in parts.iter().enumerate() {
         if let Some(g) = p.1.group {
             groups.entry(g).or_default().push(i);
         }
     }
-    let mut joints: Vec<_> = world.query_filtered::<&PartJoint, Without<GroupJoint>>().iter(world).filter_map(|j| super::spec::JointSpec::of(j, index)).collect();
-    joints.sort_by_key(|j| (j.part, j.to));
+    let mut joints: Vec<_> = joints.iter().filter_map(|j| super::spec::JointSpec::of(j, index)).collect();
+    joints.sort_by(|a, b| (a.part, a.to).cmp(&(b.part, b.to)));
     let c = x.coefficients;
-    Some(ExplodeSpec {
+    ExplodeSpec {
         degree: c.degree,
         viewing: x.viewing,
         deltas: (c.delta_explosion, c.delta_viewing, c.delta_spacing),
@@ -296,6 +326,37 @@ pub fn current_spec(world: &mut World, dataset: Entity) -> Option<ExplodeSpec> {
         groups: groups.into_values().filter(|g| g.len() > 1).collect(),
         density: parts.iter().enumerate().filter(|(_, p)| p.1.density != 1.0).map(|(i, p)| (i, p.1.density)).collect(),
         joints,
-        ..source
-    })
+        ..source.clone()
+    }
+}
+
+/// Every dataset's exploded view as it is now (`None`: not exploded), for saving.
+#[derive(Resource, Default)]
+pub struct CurrentSpecs(pub std::collections::HashMap<Entity, Option<ExplodeSpec>>);
+
+/// Keeps [`CurrentSpecs`] up to date when parts, joints or explosions change.
+#[allow(clippy::type_complexity)]
+pub fn update_current_specs(
+    datasets: Query<(Entity, Option<&ExplodeSource>, Option<&Exploded>), With<Dataset>>,
+    parts: Query<(Entity, &Part)>,
+    joints: Query<&PartJoint, Without<GroupJoint>>,
+    changed: Query<(), Or<(Changed<Part>, Changed<PartJoint>, Changed<Exploded>)>>,
+    removed: (RemovedComponents<Part>, RemovedComponents<PartJoint>, RemovedComponents<Exploded>),
+    mut out: ResMut<CurrentSpecs>,
+) {
+    let (mut a, mut b, mut c) = removed;
+    let any_removed = a.read().count() + b.read().count() + c.read().count() > 0;
+    if changed.is_empty() && !any_removed && out.0.len() == datasets.iter().len() {
+        return;
+    }
+    let joints: Vec<PartJoint> = joints.iter().cloned().collect();
+    let mut all: Vec<(Entity, &Part)> = parts.iter().collect();
+    all.sort_by_key(|p| p.0);
+    out.0 = datasets
+        .iter()
+        .map(|(e, source, x)| {
+            let mine: Vec<(Entity, &Part)> = all.iter().filter(|p| p.1.dataset == e).copied().collect();
+            (e, source.zip(x).map(|(s, x)| spec_of(&s.0, x, &mine, &joints)))
+        })
+        .collect();
 }

@@ -200,6 +200,24 @@ impl From<Plane> for PlaneSpec {
 }
 
 impl ExplodeSpec {
+    /// Around `selection`, with every default: one part, degree 0.
+    pub fn around(selection: SelectionSpec) -> ExplodeSpec {
+        ExplodeSpec {
+            selection,
+            smooth: 0,
+            look: None,
+            degree: 0.0,
+            viewing: false,
+            deltas: default_deltas(),
+            parts: PartsSpec::Whole,
+            fixed: Vec::new(),
+            hidden: Vec::new(),
+            groups: Vec::new(),
+            density: Vec::new(),
+            joints: Vec::new(),
+        }
+    }
+
     /// Checks what can be checked without the data: the message names the problem.
     pub fn validate(&self, datasets: usize) -> Result<(), String> {
         if let SelectionSpec::Labels { dataset, ids } = &self.selection {

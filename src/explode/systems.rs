@@ -43,7 +43,8 @@ impl Plugin for ExplodePlugin {
             .insert_resource(timing)
             .add_systems(ExplodeStep, apply_forces.before(PhysicsSet::SyncBackend))
             .init_resource::<super::edit::ExplodeEdits>()
-            .add_systems(Update, (super::edit::apply_edits, ensure_parts, group_joints, build_joints, update_points, sync_bodies).chain())
+            .init_resource::<super::edit::CurrentSpecs>()
+            .add_systems(Update, (super::edit::apply_edits, ensure_parts, group_joints, build_joints, update_points, sync_bodies, super::edit::update_current_specs).chain())
             .add_systems(PostUpdate, exploded_regions.in_set(RegionSystems::Modify).before(crate::windows::systems::window_regions));
     }
 }

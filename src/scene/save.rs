@@ -22,13 +22,23 @@ pub struct DatasetState<'a> {
     pub rotation: Quat,
     pub visible: bool,
     pub clip: &'a Clipping,
+    /// Its exploded view as it is now.
+    pub explode: Option<crate::explode::spec::ExplodeSpec>,
 }
 
 impl<'a> DatasetState<'a> {
     /// A dataset as a scene file loaded it.
     pub fn of(d: &'a super::load::LoadedDataset) -> Self {
         let (_, rotation, translation) = d.transform.to_scale_rotation_translation();
-        DatasetState { spec: &d.spec, appearance: &d.appearance, translation, rotation, visible: d.visible, clip: &d.clip }
+        DatasetState {
+            spec: &d.spec,
+            appearance: &d.appearance,
+            translation,
+            rotation,
+            visible: d.visible,
+            clip: &d.clip,
+            explode: d.spec.explode.clone(),
+        }
     }
 }
 
@@ -126,8 +136,7 @@ pub fn scene_file(
                 rotation_deg: (x.to_degrees(), y.to_degrees(), z.to_degrees()),
                 visible: d.visible,
                 clip: d.clip.clone(),
-                // (The app does not edit exploded views yet: what was loaded.)
-                explode: d.spec.explode.clone(),
+                explode: d.explode.clone(),
             }
         })
         .collect();

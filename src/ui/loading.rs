@@ -113,6 +113,7 @@ pub fn finish_loads(
     mut loads: Query<(Entity, &mut Loading)>,
     old: Query<Entity, With<Dataset>>,
     old_lenses: Query<Entity, With<Lens>>,
+    old_parts: Query<Entity, With<crate::explode::Part>>,
     mut session: ResMut<Session>,
     mut light: ResMut<SceneLight>,
 ) {
@@ -121,7 +122,7 @@ pub fn finish_loads(
         commands.entity(entity).despawn();
         match result {
             Ok((scene, base, datasets, is_scene)) => {
-                for e in &old {
+                for e in old.iter().chain(&old_parts) {
                     commands.entity(e).despawn();
                 }
                 if is_scene {
@@ -145,6 +146,15 @@ pub fn finish_loads(
                             .id()
                     })
                     .collect();
+                // Exploded datasets get their parts and joints, at rest.
+                let explosions: Vec<_> = datasets.iter().zip(&entities).filter_map(|(d, e)| Some((*e, d.explode.clone()?))).collect();
+                if !explosions.is_empty() {
+                    commands.queue(move |world: &mut World| {
+                        for (e, x) in &explosions {
+                            crate::explode::spec::replace_explosion(world, *e, Some(x));
+                        }
+                    });
+                }
                 let mut window_error = None;
                 if is_scene {
                     // A scene's windows replace the current ones.

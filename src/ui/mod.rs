@@ -7,6 +7,7 @@
 
 pub mod clip_gizmo;
 pub mod clip_panel;
+pub mod explode_panel;
 pub mod lenses;
 pub mod loading;
 pub mod objects_panel;
@@ -50,6 +51,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Right-click a window", "its parameter menu"),
     ("T", "3D pointer on / off (follows the cursor; wheel: depth; G: onto the surface)"),
     ("Space / Shift+Space / Backspace", "pointer: place a marker / move the nearest / delete it"),
+    ("E", "exploded view panel (splitters: click a part; line: drag; Esc: stop)"),
     ("V", "fly-through on / off (drag: look; arrows, Page Up / Down, wheel: move)"),
     ("Double-click", "centre on the point under the cursor"),
     ("R", "reset the camera"),
@@ -70,6 +72,8 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
 pub struct AppState {
     pub show_help: bool,
     pub show_fps: bool,
+    /// The exploded view's panel.
+    pub show_explode: bool,
     pub background: [f32; 3],
     pub view: VolumeView,
     /// The dataset the panels edit (index among the datasets).
@@ -97,6 +101,7 @@ impl Default for AppState {
         Self {
             show_help: false,
             show_fps: false,
+            show_explode: false,
             background: [0.0; 3],
             view: VolumeView::default(),
             selected: 0,
@@ -131,6 +136,7 @@ impl Plugin for FocalAppPlugin {
             .init_resource::<lenses::LensUi>()
             .init_resource::<clip_gizmo::ClipGizmo>()
             .init_resource::<window_tools::WindowTools>()
+            .init_resource::<explode_panel::ExplodeUi>()
             .add_systems(
                 Startup,
                 move |mut commands: Commands, mut egui: ResMut<EguiGlobalSettings>, mut load: MessageWriter<LoadRequest>| {
@@ -146,6 +152,7 @@ impl Plugin for FocalAppPlugin {
                 (
                     lenses::lens_input,
                     lenses::lens_keys,
+                    explode_panel::explode_input,
                     clip_gizmo::clip_input,
                     window_tools::window_input,
                     orbit::orbit_input,
@@ -160,7 +167,9 @@ impl Plugin for FocalAppPlugin {
                 )
                     .chain(),
             )
-            .add_systems(EguiPrimaryContextPass, panels::ui);
+            // The exploded views' physics: as many steps as the frame's time asks for.
+            .add_systems(Update, (crate::explode::systems::run_steps, open_explode_panel).after(orbit::apply_orbit))
+            .add_systems(EguiPrimaryContextPass, (panels::ui, explode_panel::explode_panel).chain());
     }
 }
 
@@ -232,6 +241,9 @@ fn shortcuts(
     if keys.just_pressed(KeyCode::KeyF) {
         state.show_fps = !state.show_fps;
     }
+    if keys.just_pressed(KeyCode::KeyE) {
+        state.show_explode = !state.show_explode;
+    }
     if keys.just_pressed(KeyCode::F12) || (keys.just_pressed(KeyCode::KeyS) && !ctrl) {
         let path = screenshot_path();
         commands.spawn(Screenshot::primary_window()).observe(save_to_disk(path.clone()));
@@ -285,6 +297,16 @@ fn shortcuts(
     if keys.just_pressed(KeyCode::KeyV) {
         toggle_fly(&mut orbit, bounds);
     }
+}
+
+/// Opens the exploded view's panel when a dataset is exploded (a scene that explodes
+/// one, or the panel's own Explode) and selects it.
+fn open_explode_panel(added: Query<Entity, Added<crate::explode::Exploded>>, datasets: Query<Entity, With<crate::dataset::Dataset>>, mut state: ResMut<AppState>) {
+    let Some(e) = added.iter().min() else { return };
+    let mut all: Vec<Entity> = datasets.iter().collect();
+    all.sort();
+    state.show_explode = true;
+    state.selected = all.iter().position(|d| *d == e).unwrap_or(state.selected);
 }
 
 /// Turns fly-through on or off; its speed follows the scene's size.

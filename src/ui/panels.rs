@@ -81,6 +81,7 @@ pub fn ui(
     mut lens_params: lenses::LensParams,
     clip_gizmo: Res<super::clip_gizmo::ClipGizmo>,
     mut window_params: super::windows_panel::WindowParams,
+    explode_specs: Res<crate::explode::edit::CurrentSpecs>,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(
@@ -111,6 +112,7 @@ pub fn ui(
             ui.menu_button("View", |ui| {
                 ui.checkbox(&mut state.show_help, "Help  (H)");
                 ui.checkbox(&mut state.show_fps, "Frame rate  (F)");
+                ui.checkbox(&mut state.show_explode, "Exploded view  (E)");
             });
             for l in &loading {
                 ui.separator();
@@ -292,6 +294,7 @@ pub fn ui(
                     &session,
                     &lens_params.ordered().into_iter().map(|(_, l, _)| l).collect::<Vec<_>>(),
                     windows,
+                    &explode_specs,
                 );
                 if let Err(e) = result {
                     session.error = Some(e);
@@ -488,12 +491,12 @@ fn mode_name(m: Mode) -> &'static str {
     }
 }
 
-type DatasetRow<'a> = (&'a DatasetOrigin, &'a Dataset, &'a Transform);
+type DatasetRow<'a> = (Entity, &'a DatasetOrigin, &'a Dataset, &'a Transform);
 
 fn ds_states<'a>(datasets: &'a DatasetQuery) -> Vec<DatasetRow<'a>> {
-    let mut rows: Vec<_> = datasets.iter().filter_map(|(e, d, _, o, t)| o.map(|o| (e, (o, d, t)))).collect();
-    rows.sort_by_key(|(e, _)| *e);
-    rows.into_iter().map(|(_, r)| r).collect()
+    let mut rows: Vec<_> = datasets.iter().filter_map(|(e, d, _, o, t)| o.map(|o| (e, o, d, t))).collect();
+    rows.sort_by_key(|r| r.0);
+    rows
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -506,11 +509,13 @@ fn save_scene(
     session: &Session,
     lenses: &[crate::lens::Lens],
     windows: crate::windows::spec::WindowScene,
+    explode: &crate::explode::edit::CurrentSpecs,
 ) -> Result<(), String> {
     use crate::scene::save::{DatasetState, scene_file};
     let states: Vec<DatasetState> = rows
         .iter()
-        .map(|(o, d, t)| DatasetState {
+        .map(|(e, o, d, t)| DatasetState {
+            explode: explode.0.get(e).cloned().unwrap_or_else(|| o.0.explode.clone()),
             spec: &o.0,
             appearance: &d.appearance,
             translation: t.translation,
