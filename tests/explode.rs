@@ -317,3 +317,47 @@ fn the_viewing_force_clears_the_view_and_follows_the_camera() {
     assert!(viewed[1].1 < viewed[1].0, "after turning: {:?}", viewed[1]);
     assert!(viewed[1].1 < plain[1].1, "{viewed:?} vs {plain:?}");
 }
+
+#[test]
+fn parts_in_the_way_fade_by_the_viewing_force() {
+    use focal::explode::components::PartFade;
+    use focal::explode::spec::ExplodeSpec;
+    let mut app = app();
+    let (dataset, parts) = exploded_head(&mut app, 2);
+    let eye = Vec3::new(0.0, 700.0, 0.0);
+    app.world_mut().spawn((focal::windows::Viewer, Transform::from_translation(eye)));
+    {
+        let mut x = app.world_mut().get_mut::<Exploded>(dataset).unwrap();
+        x.coefficients.degree = 1.0;
+        x.viewing = true;
+        x.fade = true;
+    }
+    app.update();
+    step(app.world_mut(), 5);
+    app.update();
+    let fade = |app: &App, e: Entity| app.world().get::<PartFade>(e).unwrap().0;
+    let (front, back): (Vec<Entity>, Vec<Entity>) = parts.iter().partition(|&&e| app.world().get::<Part>(e).unwrap().rest.centroid().y > 0.0);
+    // The front octants lie between the eye and the selection; the back ones behind it.
+    for (&f, &b) in front.iter().zip(&back) {
+        assert!(fade(&app, f) < 0.6 && fade(&app, b) > fade(&app, f), "front {} back {}", fade(&app, f), fade(&app, b));
+    }
+    // The regions draw the front parts with their opacity scaled, the back ones less so.
+    let scene = &app.world().resource::<focal::dataset::SceneRegions>().scene;
+    let max_opacity = |i: usize| match &scene.appearances[scene.regions[i].appearance].lookup {
+        focal::region::Lookup::Transfer(tf) => tf.opacity.iter().map(|p| p.1).fold(0.0, f32::max),
+        _ => 1.0,
+    };
+    let full = presets::builtin("ct_skin_bone").unwrap().opacity.iter().map(|p| p.1).fold(0.0, f32::max);
+    let scaled: Vec<f32> = (0..8).map(|i| max_opacity(i) / full).collect();
+    let mut fades: Vec<f32> = parts.iter().map(|e| fade(&app, *e)).collect();
+    let mut got = scaled.clone();
+    fades.sort_by(f32::total_cmp);
+    got.sort_by(f32::total_cmp);
+    assert!(fades.iter().zip(&got).all(|(a, b)| (a - b).abs() < 1e-4), "{fades:?} vs {got:?}");
+    // Off, every part is opaque again; the spec carries the switch.
+    app.world_mut().get_mut::<Exploded>(dataset).unwrap().fade = false;
+    step(app.world_mut(), 1);
+    assert!(parts.iter().all(|e| fade(&app, *e) == 1.0));
+    let spec: ExplodeSpec = ron::from_str("(selection: Range(lo: 0.0, hi: 1.0), fade: true)").unwrap();
+    assert!(spec.exploded(Phantom::Sphere.generate(8).unwrap(), None).fade);
+}

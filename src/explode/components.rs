@@ -22,6 +22,9 @@ pub struct Exploded {
     pub coefficients: Coefficients,
     /// Whether the viewing force acts (figure 5 of the paper: off and on).
     pub viewing: bool,
+    /// Parts fade by the viewing force on them (figure 9: a part in the way of the
+    /// selection turns transparent; [`super::forces::fade`]).
+    pub fade: bool,
     /// The selection: a degree-of-interest volume ([`SelectionVolume::volume`]) placed
     /// by its grid in the dataset's frame; `None`: nothing selected, no explosion points.
     /// The parts draw the data less the selection, the selection its own region (not
@@ -35,7 +38,7 @@ pub struct Exploded {
 
 impl Default for Exploded {
     fn default() -> Self {
-        Exploded { coefficients: Coefficients::default(), viewing: false, selection: None, selection_look: None, max_points: 64 }
+        Exploded { coefficients: Coefficients::default(), viewing: false, fade: false, selection: None, selection_look: None, max_points: 64 }
     }
 }
 
@@ -51,6 +54,16 @@ impl Exploded {
 #[derive(Component, Clone, Debug, Default, PartialEq)]
 pub struct ExplosionPoints {
     pub points: Vec<ExplosionPoint>,
+}
+
+/// A part's opacity factor by the viewing force (1 unless its dataset fades parts).
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct PartFade(pub f32);
+
+impl Default for PartFade {
+    fn default() -> Self {
+        PartFade(1.0)
+    }
 }
 
 /// One part of an exploded dataset.

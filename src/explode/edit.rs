@@ -319,6 +319,7 @@ pub fn spec_of(source: &ExplodeSpec, x: &Exploded, parts: &[(Entity, &Part)], jo
     ExplodeSpec {
         degree: c.degree,
         viewing: x.viewing,
+        fade: x.fade,
         deltas: (c.delta_explosion, c.delta_viewing, c.delta_spacing),
         parts: PartsSpec::Parts(parts.iter().map(|p| p.1.rest.planes.iter().map(|pl| PlaneSpec::from(*pl)).collect()).collect()),
         fixed: flagged(&|p| p.fixed),

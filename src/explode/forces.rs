@@ -90,12 +90,17 @@ pub struct Push {
 pub struct Wrench {
     pub force: Vec3,
     pub torque: Vec3,
+    /// How much the part is in the way of the view, 0..1: the weighted mean over the
+    /// explosion points of `1 / (1 + d)`, `d` the part's distance from the sight line to
+    /// the point in length units (1: every sight line crosses it; 0 without the viewing
+    /// force).
+    pub in_view: f32,
 }
 
 impl Wrench {
     /// The sum of `pushes` as a force and a torque about `center`.
     pub fn about(center: Vec3, pushes: impl IntoIterator<Item = Push>) -> Wrench {
-        pushes.into_iter().fold(Wrench::default(), |w, p| Wrench { force: w.force + p.force, torque: w.torque + (p.at - center).cross(p.force) })
+        pushes.into_iter().fold(Wrench::default(), |w, p| Wrench { force: w.force + p.force, torque: w.torque + (p.at - center).cross(p.force), ..w })
     }
 }
 
@@ -129,13 +134,16 @@ pub fn explosion_force(point: Vec3, closest: Vec3, c_e: f32, scale: Scale) -> Ve
     r.normalize_or_zero() * c_e * (-d).exp() * scale.force
 }
 
-/// Equation 3's direction and distance: from the viewing ray (the line from `eye` along
-/// `dir`) to the part's point closest to it, perpendicular to the ray; through the part,
+/// Equation 3's direction and distance: from the viewing ray (the segment from `eye` to
+/// the explosion point `eye + dir`) to the part's point closest to it, perpendicular to the ray; through the part,
 /// from the ray to `center`. Returns the push's direction, its normalised length and the
 /// point it acts at.
 pub fn off_ray(eye: Vec3, dir: Vec3, part: &Polyhedron, center: Vec3, scale: Scale) -> (Vec3, f32, Vec3) {
+    // The sight line ends at the explosion point (`eye + dir`): parts behind it do not
+    // hide it.
+    let length = dir.length();
     let dir = dir.normalize_or(Vec3::NEG_Z);
-    let foot = |p: Vec3| eye + dir * (p - eye).dot(dir).max(0.0);
+    let foot = |p: Vec3| eye + dir * (p - eye).dot(dir).clamp(0.0, length);
     // The ray's point nearest the centre, then the part's point nearest that, twice
     // (close enough to the nearest pair for a convex part and a line).
     let mut on_ray = foot(center);
@@ -143,7 +151,9 @@ pub fn off_ray(eye: Vec3, dir: Vec3, part: &Polyhedron, center: Vec3, scale: Sca
     on_ray = foot(x);
     x = part.closest_point(on_ray);
     let r = x - on_ray;
-    let perpendicular = r - dir * r.dot(dir);
+    // Beside the sight line: perpendicular to it; beyond its end: from the point.
+    let beyond = (x - eye).dot(dir) > length;
+    let perpendicular = if beyond { r } else { r - dir * r.dot(dir) };
     if perpendicular.length() > 1e-6 * scale.length {
         return (perpendicular.normalize(), perpendicular.length() / scale.length, x);
     }
@@ -201,6 +211,7 @@ pub fn part_wrench(part: &PartNow, around: &Surroundings, c: &Coefficients, scal
         Push { force: return_force(now, *v, c.returning, scale) / n, at: now }
     });
     let mut pushes: Vec<Push> = returns.collect();
+    let mut in_view = 0.0;
     let total: f32 = around.points.iter().map(|p| p.weight).sum();
     if total > 0.0 && c.degree != 0.0 {
         // Closest points in the part's rest frame (the motion is rigid: distances keep).
@@ -214,6 +225,7 @@ pub fn part_wrench(part: &PartNow, around: &Surroundings, c: &Coefficients, scal
                 let (eye_rest, dir_rest) = (back.transform_point3(eye), back.transform_vector3(p.position - eye));
                 let (dir, d, at) = off_ray(eye_rest, dir_rest, part.rest, rest_center, scale);
                 let (dir, at) = (m.transform_vector3(dir), m.transform_point3(at));
+                in_view += p.weight / total / (1.0 + d);
                 pushes.push(Push { force: viewing_force(dir, d, c.viewing(), scale) * (p.weight / total), at });
             }
         }
@@ -229,7 +241,17 @@ pub fn part_wrench(part: &PartNow, around: &Surroundings, c: &Coefficients, scal
     let rest_center = part.rest.centroid();
     let radius = part.rest.vertices.iter().map(|v| v.distance(rest_center)).fold(0.0, f32::max);
     w.torque += return_torque(rotation, radius, c.returning, scale);
+    w.in_view = in_view;
     w
+}
+
+/// The opacity of a part that fades by the viewing force (figure 9 of the paper): from 1
+/// for a part out of the view (`in_view` = 0) down to `floor` for one every sight line
+/// crosses (`in_view` = 1), linearly; quantised to twentieths so the looks change only in
+/// steps.
+pub fn fade(in_view: f32, floor: f32) -> f32 {
+    let o = 1.0 - (1.0 - floor) * in_view.clamp(0.0, 1.0);
+    ((o * 20.0).round() / 20.0).clamp(floor, 1.0)
 }
 
 #[cfg(test)]
@@ -269,6 +291,31 @@ mod tests {
     }
 
     #[test]
+    fn fading_by_the_viewing_force() {
+        assert_eq!(fade(0.0, 0.1), 1.0);
+        assert_eq!(fade(0.5, 0.1), 0.55);
+        assert_eq!(fade(1.0, 0.1), 0.1, "the floor keeps some context");
+        assert_eq!(fade(7.0, 0.1), 0.1);
+        assert_eq!(fade(0.04, 0.1), 0.95, "in twentieths: 1 − 0.9·0.04 = 0.964");
+        // A part a ray crosses (distance 0: the push at MIN_DISTANCE) is in the view far
+        // more than a part beside the ray.
+        let cube = Polyhedron::cuboid(Vec3::new(-1.0, -1.0, -6.0), Vec3::new(1.0, 1.0, -4.0));
+        let beside = Polyhedron::cuboid(Vec3::new(6.0, -1.0, -6.0), Vec3::new(8.0, 1.0, -4.0));
+        let points = [ExplosionPoint { position: Vec3::new(0.0, 0.0, -10.0), weight: 1.0 }];
+        let centers = [cube.centroid(), beside.centroid()];
+        let around = Surroundings { points: &points, centers: &centers, eye: Some(Vec3::ZERO) };
+        let c = Coefficients { degree: 1.0, ..Default::default() };
+        let w = |index: usize, rest: &Polyhedron| {
+            part_wrench(&PartNow { index, rest, to_world: Affine3A::IDENTITY, center_of_mass: rest.centroid() }, &around, &c, UNIT).in_view
+        };
+        let (front, side) = (w(0, &cube), w(1, &beside));
+        // Beside: 6 mm = 3ℓ off the sight line: 1/(1 + 3); crossed: 1.
+        assert!((side - 0.25).abs() < 1e-3, "{side}");
+        assert!((front - 1.0).abs() < 1e-5, "{front}");
+        assert!(fade(front, 0.1) < fade(side, 0.1));
+    }
+
+    #[test]
     fn wrenches_and_viewing_rays() {
         // A unit push along y at (1, 0, 0) about the origin: torque x̂ × ŷ = ẑ.
         let w = Wrench::about(Vec3::ZERO, [Push { force: Vec3::Y, at: Vec3::X }, Push { force: Vec3::Y, at: -Vec3::X }]);
@@ -277,11 +324,14 @@ mod tests {
         // A cube 3 mm to the side of a ray along −z: pushed along +x, its near face 2 mm
         // = 1ℓ off the ray.
         let cube = Polyhedron::cuboid(Vec3::new(2.0, -1.0, -6.0), Vec3::new(4.0, 1.0, -4.0));
-        let (dir, d, at) = off_ray(Vec3::ZERO, Vec3::NEG_Z, &cube, cube.centroid(), UNIT);
+        let (dir, d, at) = off_ray(Vec3::ZERO, Vec3::NEG_Z * 10.0, &cube, cube.centroid(), UNIT);
         assert!((dir - Vec3::X).length() < 1e-5 && (d - 1.0).abs() < 1e-4 && (at.x - 2.0).abs() < 1e-4, "{dir} {d} {at}");
         // The ray through the cube: pushed from the ray towards its centre, at distance 0.
-        let (dir, d, _) = off_ray(Vec3::new(2.5, 0.0, 0.0), Vec3::NEG_Z, &cube, cube.centroid(), UNIT);
+        let (dir, d, _) = off_ray(Vec3::new(2.5, 0.0, 0.0), Vec3::NEG_Z * 10.0, &cube, cube.centroid(), UNIT);
         assert!((dir - Vec3::X).length() < 1e-5 && d == 0.0);
+        // A part behind the point is not in its way: its distance is from the point.
+        let (_, d, _) = off_ray(Vec3::new(2.5, 0.0, 0.0), Vec3::NEG_Z * 2.0, &cube, cube.centroid(), UNIT);
+        assert!((d - 1.0).abs() < 1e-4, "2 mm behind the point: {d}");
     }
 
     #[test]

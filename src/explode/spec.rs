@@ -55,6 +55,9 @@ pub struct ExplodeSpec {
     pub degree: f32,
     #[serde(default)]
     pub viewing: bool,
+    /// Parts fade by the viewing force on them (figure 9).
+    #[serde(default)]
+    pub fade: bool,
     /// δ_e, δ_v, δ_s of equation 5.
     #[serde(default = "default_deltas")]
     pub deltas: (f32, f32, f32),
@@ -208,6 +211,7 @@ impl ExplodeSpec {
             look: None,
             degree: 0.0,
             viewing: false,
+            fade: false,
             deltas: default_deltas(),
             parts: PartsSpec::Whole,
             fixed: Vec::new(),
@@ -346,6 +350,7 @@ impl ExplodeSpec {
         Exploded {
             coefficients: Coefficients { degree: self.degree, delta_explosion: e, delta_viewing: v, delta_spacing: s, ..Default::default() },
             viewing: self.viewing,
+            fade: self.fade,
             selection: Some(Arc::new(selection)),
             selection_look: look,
             ..Default::default()

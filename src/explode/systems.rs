@@ -12,7 +12,8 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 use bevy_rapier3d::rapier::dynamics::IntegrationParameters;
 
-use super::components::{ExplodeTiming, Exploded, ExplosionPoints, Part};
+use super::components::{ExplodeTiming, Exploded, ExplosionPoints, Part, PartFade};
+use super::forces::fade;
 use super::forces::{PartNow, Scale, Surroundings, part_wrench};
 use super::joints::{build_joints, group_joints};
 use super::parts::Polyhedron;
@@ -119,6 +120,7 @@ fn body(part: &Part, volume: &Volume) -> impl Bundle {
         CollisionGroups::new(Group::GROUP_2, Group::NONE),
         ExternalForce::default(),
         Velocity::default(),
+        PartFade::default(),
     )
 }
 
@@ -197,18 +199,21 @@ pub fn update_points(
     }
 }
 
+/// The least opacity a part fades to (some context stays).
+const FADE_FLOOR: f32 = 0.1;
+
 /// Sets every part's external force and torque for the coming step (equations 1–5, in
 /// the dataset's frame).
 #[allow(clippy::type_complexity)]
 pub fn apply_forces(
-    mut parts: Query<(Entity, &Part, &Transform, &mut ExternalForce)>,
+    mut parts: Query<(Entity, &Part, &Transform, &mut ExternalForce, Option<&mut PartFade>)>,
     datasets: Query<(&Dataset, &Exploded, Option<&ExplosionPoints>, &GlobalTransform)>,
     viewers: Query<&GlobalTransform, With<Viewer>>,
 ) {
     let viewer = viewers.iter().next().map(|g| g.translation());
     // Each dataset's parts, in entity order, with their centres now.
     let mut by_dataset: std::collections::BTreeMap<Entity, Vec<(Entity, Vec3)>> = Default::default();
-    for (e, p, t, _) in &parts {
+    for (e, p, t, ..) in &parts {
         by_dataset.entry(p.dataset).or_default().push((e, t.transform_point(p.rest.centroid())));
     }
     for (dataset, members) in &by_dataset {
@@ -220,13 +225,20 @@ pub fn apply_forces(
         let e = d.volume.grid.extent();
         let box_volume = (e.x * e.y * e.z).max(1e-9);
         for (index, (e, center)) in members.iter().enumerate() {
-            let Ok((_, p, t, mut force)) = parts.get_mut(*e) else { continue };
-            if p.fixed {
-                continue;
-            }
+            let Ok((_, p, t, mut force, part_fade)) = parts.get_mut(*e) else { continue };
             let scale = force_scale(&d.volume, p.rest.volume() / box_volume);
             let now = PartNow { index, rest: &p.rest, to_world: t.compute_affine(), center_of_mass: *center };
             let w = part_wrench(&now, &around, &x.coefficients, scale);
+            // Fixed parts fade too (they are in the way as much).
+            let o = if x.fade && eye.is_some() { fade(w.in_view, FADE_FLOOR) } else { 1.0 };
+            if let Some(mut f) = part_fade
+                && f.0 != o
+            {
+                f.0 = o;
+            }
+            if p.fixed {
+                continue;
+            }
             let f = ExternalForce { force: w.force, torque: w.torque };
             if *force != f {
                 *force = f;
@@ -239,7 +251,7 @@ pub fn apply_forces(
 /// the selection) and the selection's own region (its box, not moved, drawing the data
 /// in the selection), the parts first.
 pub fn exploded_regions(
-    parts: Query<(&Part, &Transform)>,
+    parts: Query<(&Part, &Transform, Option<&PartFade>)>,
     datasets: Query<(Entity, &Dataset, &Exploded, Option<&GpuVolume>, &GlobalTransform)>,
     mut out: ResMut<SceneRegions>,
 ) {
@@ -261,21 +273,34 @@ pub fn exploded_regions(
     targets.sort_by_key(|t| std::cmp::Reverse(t.0));
     for (region_index, volume_index, entity) in targets {
         let Ok((_, d, x, gpu, global)) = datasets.get(entity) else { continue };
-        if parts.iter().all(|(p, _)| p.dataset != entity) {
+        if parts.iter().all(|(p, ..)| p.dataset != entity) {
             continue;
         }
-        let placed: Vec<PlacedPart> =
-            parts.iter().filter(|(p, _)| p.dataset == entity && !p.hidden).map(|(p, t)| PlacedPart { rest: &p.rest, motion: t.compute_affine() }).collect();
+        let visible: Vec<_> = parts.iter().filter(|(p, ..)| p.dataset == entity && !p.hidden).collect();
+        let placed: Vec<PlacedPart> = visible.iter().map(|(p, t, _)| PlacedPart { rest: &p.rest, motion: t.compute_affine() }).collect();
+        let fades: Vec<f32> = visible.iter().map(|(.., f)| f.map_or(1.0, |f| f.0)).collect();
         let grid = &shown(d, gpu).grid;
         let mut regions = part_regions(grid, global.affine(), &d.clip, volume_index, &placed);
-        if let Some(selection) = &x.selection {
-            let weighted = |look: &Appearance, keep: Keep| Appearance { selection: Some(SelectionWeight { volume: selection.clone(), keep }), ..look.clone() };
-            let own = scene.appearances.get(volume_index).cloned().unwrap_or_else(|| d.appearance.clone());
-            scene.appearances.push(weighted(&own, Keep::Unselected));
-            let rest = scene.appearances.len() - 1;
-            for r in &mut regions {
-                r.appearance = rest;
-            }
+        let own = scene.appearances.get(volume_index).cloned().unwrap_or_else(|| d.appearance.clone());
+        let weighted = |look: &Appearance, keep: Keep| match &x.selection {
+            Some(selection) => Appearance { selection: Some(SelectionWeight { volume: selection.clone(), keep }), ..look.clone() },
+            None => look.clone(),
+        };
+        // The parts' look: the data less the selection, faded per part (one look per
+        // opacity step).
+        let mut looks: Vec<(u32, usize)> = Vec::new();
+        for (r, o) in regions.iter_mut().zip(&fades) {
+            let key = (o * 1000.0).round() as u32;
+            r.appearance = match looks.iter().find(|l| l.0 == key) {
+                Some(l) => l.1,
+                None => {
+                    scene.appearances.push(weighted(&own, Keep::Unselected).with_opacity_scaled(*o));
+                    looks.push((key, scene.appearances.len() - 1));
+                    scene.appearances.len() - 1
+                }
+            };
+        }
+        if x.selection.is_some() {
             scene.appearances.push(weighted(x.selection_look.as_ref().unwrap_or(&own), Keep::Selected));
             regions.push(Region { appearance: scene.appearances.len() - 1, ..Region::dataset(grid, global.affine(), &d.clip, volume_index) });
         }

@@ -197,6 +197,23 @@ impl Appearance {
     /// range maps only to zero opacity adds nothing. `None` for modes that look at every
     /// sample (projections, iso-surfaces). Segmented volumes: see
     /// [`Segmentation::brick_occupancy`].
+    /// The same look with every opacity times `scale` (in 0..1; an exploded part fading
+    /// by the viewing force). Segmentations' objects keep theirs.
+    pub fn with_opacity_scaled(mut self, scale: f32) -> Appearance {
+        if scale >= 1.0 {
+            return self;
+        }
+        let s = scale.clamp(0.0, 1.0);
+        match &mut self.lookup {
+            Lookup::Transfer(tf) => tf.opacity.iter_mut().for_each(|p| p.1 *= s),
+            Lookup::Labels(l) => {
+                l.default_opacity *= s;
+                l.styles.values_mut().for_each(|st| st.opacity *= s);
+            }
+        }
+        self
+    }
+
     pub fn brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {
         let occupancy = match &self.segmentation {
             Some(seg) => Some(seg.brick_occupancy(volume, self.own_brick_occupancy(volume))),

@@ -435,6 +435,9 @@ pub enum Change {
         viewing: Option<bool>,
         #[serde(default)]
         deltas: Option<(f32, f32, f32)>,
+        /// Parts fade by the viewing force on them (figure 9).
+        #[serde(default)]
+        fade: Option<bool>,
     },
 }
 

@@ -350,7 +350,7 @@ pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneF
         Change::Windows(w) => scene.windows = w.clone(),
         Change::Pointer(p) => scene.pointer = *p,
         Change::Rendering(r) => scene.rendering = *r,
-        Change::Explode { dataset, degree, viewing, deltas } => {
+        Change::Explode { dataset, degree, viewing, deltas, fade } => {
             let x = datasets[get(*dataset)?].explode.as_mut().ok_or_else(|| format!("Explode: dataset {dataset} is not exploded"))?;
             let c = &mut x.exploded.coefficients;
             if let Some(d) = degree {
@@ -361,6 +361,9 @@ pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneF
             }
             if let Some(v) = viewing {
                 x.exploded.viewing = *v;
+            }
+            if let Some(f) = fade {
+                x.exploded.fade = *f;
             }
         }
     }

@@ -118,10 +118,11 @@ impl GpuRun {
             // the frame's changes.
             if let Some(x) = &d.explode
                 && let Some(mut now) = self.off.world_mut().get_mut::<crate::explode::Exploded>(*e)
-                && (now.coefficients != x.exploded.coefficients || now.viewing != x.exploded.viewing)
+                && (now.coefficients != x.exploded.coefficients || now.viewing != x.exploded.viewing || now.fade != x.exploded.fade)
             {
                 now.coefficients = x.exploded.coefficients;
                 now.viewing = x.exploded.viewing;
+                now.fade = x.exploded.fade;
             }
         }
         self.off.world_mut().insert_resource(SceneLight(scene.light));

@@ -204,6 +204,7 @@ pub fn explode_panel(
             Ok(mut x) => {
                 ui.add(egui::Slider::new(&mut x.coefficients.degree, 0.0..=16.0).text("degree of explosion"));
                 ui.checkbox(&mut x.viewing, "viewing force (parts leave the lines of sight)");
+                ui.add_enabled(x.viewing, egui::Checkbox::new(&mut x.fade, "parts in the way fade (figure 9)"));
                 egui::CollapsingHeader::new("Advanced (δ of equation 5)").show(ui, |ui| {
                     ui.add(egui::Slider::new(&mut x.coefficients.delta_explosion, 0.0..=2.0).text("δ explosion"));
                     ui.add(egui::Slider::new(&mut x.coefficients.delta_viewing, 0.0..=2.0).text("δ viewing"));
