@@ -13,7 +13,9 @@
 //! (two-level rendering of the head CT split by its labels against no objects),
 //! `--windows` (volumetric windows against none, [`windows`]: one and four clip windows
 //! showing the dataset as it is, goals ≤ ×1.10 and ≤ ×1.33; the cutaway, the windows of
-//! the paper's figures 3–6, a window over the head without clip, two halves). Each line
+//! the paper's figures 3–6, a window over the head without clip, two halves),
+//! `--explode` (exploded views, [`explode`]: the paper's table 1, 1 to 64 parts at rest
+//! and exploded against the plain ray caster; goal ≥ 80 % at 64 parts). Each line
 //! ends with the ratio against its group's baseline; `--json` prints the same as JSON,
 //! `--save DIR` writes each configuration's picture, and `FOCAL_BENCH_SAMPLES=1` prints
 //! every timed frame (frame times on llvmpipe scatter by ±15 %: time enough frames).
@@ -36,6 +38,7 @@ use focal::volume::Volume;
 use focal::volume::phantom::{self, Phantom};
 use serde_json::json;
 
+mod explode;
 mod windows;
 
 #[derive(Args)]
@@ -70,6 +73,9 @@ pub struct BenchArgs {
     /// Only the volumetric windows group.
     #[arg(long)]
     windows: bool,
+    /// Only the exploded views group (the paper's table 1).
+    #[arg(long)]
+    explode: bool,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -251,7 +257,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         .split_once('x')
         .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
         .ok_or_else(|| format!("size '{}' is not WIDTHxHEIGHT", args.size))?;
-    let all = !(args.skipping || args.termination || args.modes || args.lenses || args.context || args.twolevel || args.windows);
+    let all = !(args.skipping || args.termination || args.modes || args.lenses || args.context || args.twolevel || args.windows || args.explode);
     let off = Offscreen::new(w, h, |app| {
         app.add_plugins(FocalPlugins);
     })?;
@@ -368,6 +374,10 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
 
     if all || args.windows {
         windows::group(&mut bench, &mut rows, args.resolution)?;
+    }
+
+    if all || args.explode {
+        explode::group(&mut bench, &mut rows, args.resolution)?;
     }
 
     if all || args.lenses {
