@@ -101,7 +101,10 @@ impl Polyhedron {
     }
 
     /// The point of the polyhedron closest to `p` (`p` itself inside), by projecting onto
-    /// the faces, edges and vertices.
+    /// the faces, edges and vertices. Only faces that face `p` are tried: the closest
+    /// point lies on one (`p − q` is in the cone of the normals of the faces at `q`, so
+    /// it has a positive part along one of them). Faces wind counterclockwise about their
+    /// outward normal.
     pub fn closest_point(&self, p: Vec3) -> Vec3 {
         if self.contains(p) {
             return p;
@@ -114,7 +117,11 @@ impl Polyhedron {
         };
         for face in &self.faces {
             let n = (face[1] - face[0]).cross(face[2] - face[0]).normalize_or_zero();
-            let q = p - n * (p - face[0]).dot(n);
+            let d = (p - face[0]).dot(n);
+            if d <= 0.0 {
+                continue;
+            }
+            let q = p - n * d;
             if self.contains(q) {
                 consider(q);
             }
@@ -199,6 +206,26 @@ mod tests {
         // A plane beside the cube, or touching a face, cuts nothing.
         assert!(cube.split(Plane::through(Vec3::splat(3.0), Vec3::X)).is_none());
         assert!(cube.split(Plane::through(Vec3::ZERO, Vec3::X)).is_none());
+    }
+
+    #[test]
+    fn closest_points_are_no_farther_than_any_point_of_the_part() {
+        // A cube cut obliquely twice; points around it on a lattice; every closest point
+        // lies in the part and no lattice point of the part is nearer.
+        let cube = Polyhedron::cuboid(Vec3::ZERO, Vec3::splat(2.0));
+        let (a, _) = cube.split(Plane::through(Vec3::new(1.2, 1.0, 0.8), Vec3::new(1.0, 0.6, 0.3).normalize())).unwrap();
+        let (part, _) = a.split(Plane::through(Vec3::new(0.5, 1.0, 1.0), Vec3::new(-0.4, 1.0, 0.7).normalize())).unwrap();
+        let lattice = |n: i32, lo: f32, step: f32| {
+            (0..n * n * n).map(move |i| Vec3::new((i % n) as f32, (i / n % n) as f32, (i / (n * n)) as f32) * step + Vec3::splat(lo))
+        };
+        let inside: Vec<Vec3> = lattice(21, 0.0, 0.1).filter(|q| part.contains(*q)).chain(part.vertices.iter().copied()).collect();
+        assert!(inside.len() > 100);
+        for p in lattice(9, -1.5, 0.62) {
+            let q = part.closest_point(p);
+            assert!(part.planes.iter().all(|pl| pl.distance(q) < 1e-4), "{q} is in the part");
+            let nearest = inside.iter().map(|x| x.distance(p)).fold(f32::INFINITY, f32::min);
+            assert!(q.distance(p) <= nearest + 1e-4, "{p}: {q} at {} but a point at {nearest}", q.distance(p));
+        }
     }
 
     #[test]

@@ -8,13 +8,14 @@
 //! collide (they start touching everywhere; the spacing force keeps them apart).
 
 use bevy::ecs::schedule::ScheduleLabel;
+use bevy::math::Affine3A;
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 use bevy_rapier3d::rapier::dynamics::IntegrationParameters;
 
 use super::components::{ExplodeTiming, Exploded, ExplosionPoints, Part, PartFade};
 use super::forces::fade;
-use super::forces::{PartNow, Scale, Surroundings, part_wrench};
+use super::forces::{PartNow, Scale, Surroundings, Wrench, part_wrench};
 use super::joints::{build_joints, group_joints};
 use super::parts::Polyhedron;
 use super::points::explosion_points;
@@ -210,39 +211,52 @@ pub fn apply_forces(
     datasets: Query<(&Dataset, &Exploded, Option<&ExplosionPoints>, &GlobalTransform)>,
     viewers: Query<&GlobalTransform, With<Viewer>>,
 ) {
+    use rayon::prelude::*;
     let viewer = viewers.iter().next().map(|g| g.translation());
     // Each dataset's parts, in entity order, with their centres now.
-    let mut by_dataset: std::collections::BTreeMap<Entity, Vec<(Entity, Vec3)>> = Default::default();
+    let mut by_dataset: std::collections::BTreeMap<Entity, Vec<(Entity, &Part, Affine3A, Vec3)>> = Default::default();
     for (e, p, t, ..) in &parts {
-        by_dataset.entry(p.dataset).or_default().push((e, t.transform_point(p.rest.centroid())));
+        let m = t.compute_affine();
+        by_dataset.entry(p.dataset).or_default().push((e, p, m, m.transform_point3(p.rest.centroid())));
     }
+    // The wrenches, the parts in parallel (each reads the others' centres only).
+    let mut out: Vec<(Entity, bool, Wrench, f32)> = Vec::new();
     for (dataset, members) in &by_dataset {
         let Ok((d, x, points, global)) = datasets.get(*dataset) else { continue };
-        let centers: Vec<Vec3> = members.iter().map(|m| m.1).collect();
+        let centers: Vec<Vec3> = members.iter().map(|m| m.3).collect();
         let eye = if x.viewing { viewer.map(|v| global.affine().inverse().transform_point3(v)) } else { None };
         let empty = ExplosionPoints::default();
         let around = Surroundings { points: &points.unwrap_or(&empty).points, centers: &centers, eye };
         let e = d.volume.grid.extent();
         let box_volume = (e.x * e.y * e.z).max(1e-9);
-        for (index, (e, center)) in members.iter().enumerate() {
-            let Ok((_, p, t, mut force, part_fade)) = parts.get_mut(*e) else { continue };
-            let scale = force_scale(&d.volume, p.rest.volume() / box_volume);
-            let now = PartNow { index, rest: &p.rest, to_world: t.compute_affine(), center_of_mass: *center };
-            let w = part_wrench(&now, &around, &x.coefficients, scale);
-            // Fixed parts fade too (they are in the way as much).
-            let o = if x.fade && eye.is_some() { fade(w.in_view, FADE_FLOOR) } else { 1.0 };
-            if let Some(mut f) = part_fade
-                && f.0 != o
-            {
-                f.0 = o;
-            }
-            if p.fixed {
-                continue;
-            }
-            let f = ExternalForce { force: w.force, torque: w.torque };
-            if *force != f {
-                *force = f;
-            }
+        let wrenches: Vec<(Entity, bool, Wrench, f32)> = members
+            .par_iter()
+            .enumerate()
+            .map(|(index, (e, p, m, center))| {
+                let scale = force_scale(&d.volume, p.rest.volume() / box_volume);
+                let now = PartNow { index, rest: &p.rest, to_world: *m, center_of_mass: *center };
+                let w = part_wrench(&now, &around, &x.coefficients, scale);
+                // Fixed parts fade too (they are in the way as much).
+                let o = if x.fade && eye.is_some() { fade(w.in_view, FADE_FLOOR) } else { 1.0 };
+                (*e, p.fixed, w, o)
+            })
+            .collect();
+        out.extend(wrenches);
+    }
+    drop(by_dataset);
+    for (e, fixed, w, o) in out {
+        let Ok((_, _, _, mut force, part_fade)) = parts.get_mut(e) else { continue };
+        if let Some(mut f) = part_fade
+            && f.0 != o
+        {
+            f.0 = o;
+        }
+        if fixed {
+            continue;
+        }
+        let f = ExternalForce { force: w.force, torque: w.torque };
+        if *force != f {
+            *force = f;
         }
     }
 }
