@@ -25,7 +25,12 @@ fn exploded(grid: (u32, u32, u32)) -> Option<App> {
     let ids: BTreeSet<u32> = [6, 7, 8].into();
     let selection = SelectionVolume::from_labels(&phantom.labels, &ids).ok()?.volume;
     let ct = Arc::new(phantom.ct);
-    let spec = ExplodeSpec { parts: PartsSpec::Grid(grid), degree: 1.0, viewing: true, ..ExplodeSpec::around(SelectionSpec::Labels { dataset: 1, ids: vec![6, 7, 8] }) };
+    let spec = ExplodeSpec {
+        parts: PartsSpec::Grid(grid),
+        degree: 1.0,
+        viewing: true,
+        ..ExplodeSpec::around(SelectionSpec::Labels { dataset: 1, ids: vec![6, 7, 8] })
+    };
     let loaded = LoadedExplode { exploded: spec.exploded(selection, None), parts: spec.parts(&ct).ok()?, spec };
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, TransformPlugin, FocalCorePlugins));

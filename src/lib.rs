@@ -30,7 +30,11 @@ pub struct FocalCorePlugins;
 
 impl PluginGroup for FocalCorePlugins {
     fn build(self) -> PluginGroupBuilder {
-        PluginGroupBuilder::start::<Self>().add(dataset::DatasetPlugin).add(lens::LensPlugin).add(windows::VolumeWindowPlugin).add(explode::ExplodePlugin)
+        PluginGroupBuilder::start::<Self>()
+            .add(dataset::DatasetPlugin)
+            .add(lens::LensPlugin)
+            .add(windows::VolumeWindowPlugin)
+            .add(explode::ExplodePlugin)
     }
 }
 

@@ -199,7 +199,6 @@ fn sixty_four_parts_stay_stable_for_ten_thousand_steps() {
     assert!(worst < 1.0, "{worst} mm off");
 }
 
-
 #[test]
 fn at_rest_the_exploded_dataset_looks_as_before_and_exploded_its_selection_stays() {
     use focal::reference::render;
@@ -278,9 +277,18 @@ fn scene_files_explode_datasets() {
     assert!(joints[0].kind == focal::explode::JointKind::Hinge && joints[0].to.is_none());
     // Mistakes name the dataset and the problem.
     let err = |t: &str| SceneFile::parse(t, "t.ron").and_then(|s| s.validate().map(|_| s)).err().unwrap_or_default();
-    assert!(err("(datasets: [(source: Phantom(kind: head), explode: Some((selection: Labels(dataset: 4, ids: [1]))))])").contains("dataset 0: explode"));
-    assert!(err("(datasets: [(source: Phantom(kind: head), explode: Some((selection: Range(lo: 0.0, hi: 1.0), degre: 1.0)))])").contains("degre"));
-    assert!(err("(datasets: [(source: Phantom(kind: head))], frames: [(name: \"a\", set: [Explode(dataset: 0, degree: Some(1.0))])])").contains("not exploded"));
+    assert!(
+        err("(datasets: [(source: Phantom(kind: head), explode: Some((selection: Labels(dataset: 4, ids: [1]))))])")
+            .contains("dataset 0: explode")
+    );
+    assert!(
+        err("(datasets: [(source: Phantom(kind: head), explode: Some((selection: Range(lo: 0.0, hi: 1.0), degre: 1.0)))])")
+            .contains("degre")
+    );
+    assert!(
+        err("(datasets: [(source: Phantom(kind: head))], frames: [(name: \"a\", set: [Explode(dataset: 0, degree: Some(1.0))])])")
+            .contains("not exploded")
+    );
 }
 
 #[test]
@@ -336,7 +344,8 @@ fn parts_in_the_way_fade_by_the_viewing_force() {
     step(app.world_mut(), 5);
     app.update();
     let fade = |app: &App, e: Entity| app.world().get::<PartFade>(e).unwrap().0;
-    let (front, back): (Vec<Entity>, Vec<Entity>) = parts.iter().partition(|&&e| app.world().get::<Part>(e).unwrap().rest.centroid().y > 0.0);
+    let (front, back): (Vec<Entity>, Vec<Entity>) =
+        parts.iter().partition(|&&e| app.world().get::<Part>(e).unwrap().rest.centroid().y > 0.0);
     // The front octants lie between the eye and the selection; the back ones behind it.
     for (&f, &b) in front.iter().zip(&back) {
         assert!(fade(&app, f) < 0.6 && fade(&app, b) > fade(&app, f), "front {} back {}", fade(&app, f), fade(&app, b));

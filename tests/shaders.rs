@@ -58,7 +58,9 @@ fn every_shader_variant_composes_and_validates() {
     // Every combination the renderer can ask for: anti-aliasing only with lenses, DVR
     // pairs and selection weights only with DVR.
     let needs = |a: &str, b: &str, bits: u32| bits & bit(a) == 0 || bits & bit(b) != 0;
-    let possible = |bits: u32| needs("LENS_ANTIALIAS", "HAS_LENSES", bits) && needs("DVR_PAIRS", "HAS_DVR", bits) && needs("HAS_SELECTION", "HAS_DVR", bits);
+    let possible = |bits: u32| {
+        needs("LENS_ANTIALIAS", "HAS_LENSES", bits) && needs("DVR_PAIRS", "HAS_DVR", bits) && needs("HAS_SELECTION", "HAS_DVR", bits)
+    };
     for bits in (0u32..(1 << DEFS.len())).filter(|b| possible(*b)) {
         let defs: HashMap<String, ShaderDefValue> = DEFS
             .iter()

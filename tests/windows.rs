@@ -252,7 +252,9 @@ fn scene_windows_give_the_same_regions_in_the_app_and_the_reference() {
     assert_eq!(reference.regions.iter().map(|r| r.holes.len()).sum::<usize>(), 1);
     // Same regions, maybe in another order (the app orders windows by entity).
     let same = |a: &Region, b: &Region| {
-        let near = |p: &focal::region::Plane, q: &focal::region::Plane| (p.normal - q.normal).length() < 1e-4 && (p.offset - q.offset).abs() < 1e-2;
+        let near = |p: &focal::region::Plane, q: &focal::region::Plane| {
+            (p.normal - q.normal).length() < 1e-4 && (p.offset - q.offset).abs() < 1e-2
+        };
         a.planes.len() == b.planes.len()
             && a.planes.iter().zip(&b.planes).all(|(p, q)| near(p, q))
             && a.holes.len() == b.holes.len()

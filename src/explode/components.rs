@@ -38,7 +38,14 @@ pub struct Exploded {
 
 impl Default for Exploded {
     fn default() -> Self {
-        Exploded { coefficients: Coefficients::default(), viewing: false, fade: false, selection: None, selection_look: None, max_points: 64 }
+        Exploded {
+            coefficients: Coefficients::default(),
+            viewing: false,
+            fade: false,
+            selection: None,
+            selection_look: None,
+            max_points: 64,
+        }
     }
 }
 

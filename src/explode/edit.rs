@@ -41,15 +41,28 @@ pub enum Splitter {
 pub enum Edit {
     /// Explodes `dataset` as `spec` says (its selection's label dataset is an index into
     /// the datasets in entity order).
-    Explode { dataset: Entity, spec: Box<ExplodeSpec> },
+    Explode {
+        dataset: Entity,
+        spec: Box<ExplodeSpec>,
+    },
     /// Back to the plain dataset.
-    Unexplode { dataset: Entity },
-    Split { dataset: Entity, splitter: Splitter },
+    Unexplode {
+        dataset: Entity,
+    },
+    Split {
+        dataset: Entity,
+        splitter: Splitter,
+    },
     /// Puts the last split part of `dataset` back.
-    Undo { dataset: Entity },
+    Undo {
+        dataset: Entity,
+    },
     /// Picks the part first hit by `ray` and the point hit ([`ExplodeEdits::picked`]),
     /// for a joint.
-    Pick { dataset: Entity, ray: Ray },
+    Pick {
+        dataset: Entity,
+        ray: Ray,
+    },
 }
 
 /// A picked point on a part: the part, the point in the world and in the part's rest
@@ -119,7 +132,8 @@ pub fn apply(world: &mut World, edit: Edit) -> Result<(), String> {
             let part = part_at(world, dataset, hit).ok_or("no part under the cursor")?;
             let motion = world.get::<Transform>(part).map_or(Affine3A::IDENTITY, |t| t.compute_affine());
             let to_world = dataset_to_world(world, dataset) * motion;
-            world.resource_mut::<ExplodeEdits>().picked = Some(Picked { part, world: hit, rest: to_world.inverse().transform_point3(hit), to_world });
+            world.resource_mut::<ExplodeEdits>().picked =
+                Some(Picked { part, world: hit, rest: to_world.inverse().transform_point3(hit), to_world });
             Ok(())
         }
     }
@@ -150,7 +164,12 @@ fn explode(world: &mut World, dataset: Entity, spec: &ExplodeSpec) -> Result<(),
 
 /// The parts of `dataset`: entity, part, motion (in the dataset's frame), in entity order.
 fn parts_of(world: &mut World, dataset: Entity) -> Vec<(Entity, Part, Transform)> {
-    let mut v: Vec<_> = world.query::<(Entity, &Part, &Transform)>().iter(world).filter(|(_, p, _)| p.dataset == dataset).map(|(e, p, t)| (e, p.clone(), *t)).collect();
+    let mut v: Vec<_> = world
+        .query::<(Entity, &Part, &Transform)>()
+        .iter(world)
+        .filter(|(_, p, _)| p.dataset == dataset)
+        .map(|(e, p, t)| (e, p.clone(), *t))
+        .collect();
     v.sort_by_key(|p| p.0);
     v
 }
@@ -200,7 +219,9 @@ pub fn split(world: &mut World, dataset: Entity, splitter: &Splitter) -> Result<
             let plane = line_plane(camera, *a, *b, size.x, size.y).ok_or("the line is too short")?;
             parts_of(world, dataset)
                 .into_iter()
-                .filter(|(_, p, t)| !p.hidden && segment_crosses(camera, &p.rest, to_world * t.compute_affine(), plane, *a, *b, size.as_vec2()))
+                .filter(|(_, p, t)| {
+                    !p.hidden && segment_crosses(camera, &p.rest, to_world * t.compute_affine(), plane, *a, *b, size.as_vec2())
+                })
                 .map(|(e, ..)| (e, plane))
                 .collect()
         }

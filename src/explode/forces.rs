@@ -100,7 +100,11 @@ pub struct Wrench {
 impl Wrench {
     /// The sum of `pushes` as a force and a torque about `center`.
     pub fn about(center: Vec3, pushes: impl IntoIterator<Item = Push>) -> Wrench {
-        pushes.into_iter().fold(Wrench::default(), |w, p| Wrench { force: w.force + p.force, torque: w.torque + (p.at - center).cross(p.force), ..w })
+        pushes.into_iter().fold(Wrench::default(), |w, p| Wrench {
+            force: w.force + p.force,
+            torque: w.torque + (p.at - center).cross(p.force),
+            ..w
+        })
     }
 }
 

@@ -183,7 +183,12 @@ pub struct GroupJoint;
 
 /// Keeps the parts of each group together: every member but the group's first (in
 /// entity order) has a fixed joint to the first.
-pub fn group_joints(mut commands: Commands, parts: Query<(Entity, &Part)>, changed: Query<(), Changed<Part>>, joints: Query<(Entity, &PartJoint), With<GroupJoint>>) {
+pub fn group_joints(
+    mut commands: Commands,
+    parts: Query<(Entity, &Part)>,
+    changed: Query<(), Changed<Part>>,
+    joints: Query<(Entity, &PartJoint), With<GroupJoint>>,
+) {
     if changed.is_empty() {
         return;
     }
@@ -234,7 +239,8 @@ mod tests {
 
     #[test]
     fn limits_are_radians_on_the_free_axes() {
-        let j = PartJoint { limits: Some((90.0, -30.0)), ..PartJoint::new(JointKind::Hinge, Entity::PLACEHOLDER, None, Vec3::ONE, Vec3::Z) };
+        let j =
+            PartJoint { limits: Some((90.0, -30.0)), ..PartJoint::new(JointKind::Hinge, Entity::PLACEHOLDER, None, Vec3::ONE, Vec3::Z) };
         let g = rapier_joint(&j);
         let l = g.limits(JointAxis::AngX).map(|l| [l.min, l.max]);
         let expect = [(-30f32).to_radians(), 90f32.to_radians()];
@@ -242,7 +248,10 @@ mod tests {
         assert!(g.limits(JointAxis::LinX).is_none());
         assert_eq!(g.locked_axes(), JointKind::Hinge.locked());
         assert_eq!(g.local_anchor1(), Vec3::ONE);
-        let s = rapier_joint(&PartJoint { limits: Some((0.0, 40.0)), ..PartJoint::new(JointKind::Slider, Entity::PLACEHOLDER, None, Vec3::ZERO, Vec3::X) });
+        let s = rapier_joint(&PartJoint {
+            limits: Some((0.0, 40.0)),
+            ..PartJoint::new(JointKind::Slider, Entity::PLACEHOLDER, None, Vec3::ZERO, Vec3::X)
+        });
         assert_eq!(s.limits(JointAxis::LinX).map(|l| [l.min, l.max]), Some([0.0, 40.0]), "slider limits in mm");
         assert!(!s.contacts_enabled());
     }

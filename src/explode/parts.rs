@@ -38,10 +38,13 @@ impl Polyhedron {
 
     /// The axis-aligned box `[lo, hi]`.
     pub fn cuboid(lo: Vec3, hi: Vec3) -> Polyhedron {
-        let planes: Vec<Plane> =
-            (0..3).flat_map(|a| [Plane { normal: Vec3::AXES[a], offset: hi[a] }, Plane { normal: -Vec3::AXES[a], offset: -lo[a] }]).collect();
+        let planes: Vec<Plane> = (0..3)
+            .flat_map(|a| [Plane { normal: Vec3::AXES[a], offset: hi[a] }, Plane { normal: -Vec3::AXES[a], offset: -lo[a] }])
+            .collect();
         let vertices: Vec<Vec3> = (0..8)
-            .map(|c: usize| Vec3::new(if c & 1 == 0 { lo.x } else { hi.x }, if c & 2 == 0 { lo.y } else { hi.y }, if c & 4 == 0 { lo.z } else { hi.z }))
+            .map(|c: usize| {
+                Vec3::new(if c & 1 == 0 { lo.x } else { hi.x }, if c & 2 == 0 { lo.y } else { hi.y }, if c & 4 == 0 { lo.z } else { hi.z })
+            })
             .collect();
         let faces = faces(&planes, &vertices);
         Polyhedron { planes, vertices, faces }
@@ -85,7 +88,10 @@ impl Polyhedron {
             .iter()
             .map(|face| {
                 let a = face[0].as_dvec3();
-                face[1..].windows(2).map(|e| (a - apex).dot((e[0].as_dvec3() - apex).cross(e[1].as_dvec3() - apex)).abs() / 6.0).sum::<f64>()
+                face[1..]
+                    .windows(2)
+                    .map(|e| (a - apex).dot((e[0].as_dvec3() - apex).cross(e[1].as_dvec3() - apex)).abs() / 6.0)
+                    .sum::<f64>()
             })
             .sum::<f64>() as f32
     }
@@ -232,7 +238,8 @@ mod tests {
     fn faces_centroids_and_closest_points() {
         // A wedge: the unit cube cut by x + y ≤ 1 (a triangular prism of volume ½, its
         // centroid at (⅓, ⅓, ½)).
-        let (wedge, _) = Polyhedron::cuboid(Vec3::ZERO, Vec3::ONE).split(Plane::through(Vec3::new(0.5, 0.5, 0.0), Vec3::new(1.0, 1.0, 0.0))).unwrap();
+        let (wedge, _) =
+            Polyhedron::cuboid(Vec3::ZERO, Vec3::ONE).split(Plane::through(Vec3::new(0.5, 0.5, 0.0), Vec3::new(1.0, 1.0, 0.0))).unwrap();
         assert_eq!(wedge.vertices.len(), 6);
         assert_eq!(wedge.faces.len(), 5);
         assert!((wedge.volume() - 0.5).abs() < 1e-5);

@@ -19,7 +19,13 @@ use crate::volume::{BrickGrid, Grid};
 /// grids of the data and the selection volumes (on the same grid), `grid` the data's
 /// grid; `visible(lo, hi)` tells whether the transfer function gives the data codes
 /// `lo..=hi` any opacity. Empty when the grids differ or nothing is selected.
-pub fn explosion_points(grid: &Grid, data: &BrickGrid, selection: &BrickGrid, visible: impl Fn(u16, u16) -> bool, max_points: usize) -> Vec<ExplosionPoint> {
+pub fn explosion_points(
+    grid: &Grid,
+    data: &BrickGrid,
+    selection: &BrickGrid,
+    visible: impl Fn(u16, u16) -> bool,
+    max_points: usize,
+) -> Vec<ExplosionPoint> {
     if data.dims != selection.dims || data.size != selection.size {
         return Vec::new();
     }

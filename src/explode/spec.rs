@@ -299,7 +299,8 @@ impl ExplodeSpec {
                 .iter()
                 .enumerate()
                 .map(|(i, planes)| {
-                    Polyhedron::new(&planes.iter().map(PlaneSpec::plane).collect::<Vec<_>>()).ok_or_else(|| format!("part {i} has no volume"))
+                    Polyhedron::new(&planes.iter().map(PlaneSpec::plane).collect::<Vec<_>>())
+                        .ok_or_else(|| format!("part {i} has no volume"))
                 })
                 .collect::<Result<_, _>>()?,
         };
@@ -348,7 +349,13 @@ impl ExplodeSpec {
     pub fn exploded(&self, selection: Volume, look: Option<Appearance>) -> Exploded {
         let (e, v, s) = self.deltas;
         Exploded {
-            coefficients: Coefficients { degree: self.degree, delta_explosion: e, delta_viewing: v, delta_spacing: s, ..Default::default() },
+            coefficients: Coefficients {
+                degree: self.degree,
+                delta_explosion: e,
+                delta_viewing: v,
+                delta_spacing: s,
+                ..Default::default()
+            },
             viewing: self.viewing,
             fade: self.fade,
             selection: Some(Arc::new(selection)),
@@ -443,7 +450,8 @@ mod tests {
         assert!(bad.validate(1).unwrap_err().contains("not a range"));
         let bad: ExplodeSpec = ron::from_str("(selection: Range(lo: 0.0, hi: 1.0), parts: Grid((0, 1, 1)))").unwrap();
         assert!(bad.validate(1).unwrap_err().contains("grid"));
-        let bad: ExplodeSpec = ron::from_str("(selection: Range(lo: 0.0, hi: 1.0), parts: Planes([(normal: (0.0, 0.0, 0.0), offset: 1.0)]))").unwrap();
+        let bad: ExplodeSpec =
+            ron::from_str("(selection: Range(lo: 0.0, hi: 1.0), parts: Planes([(normal: (0.0, 0.0, 0.0), offset: 1.0)]))").unwrap();
         assert!(bad.validate(1).unwrap_err().contains("plane 0"));
         let far: ExplodeSpec = ron::from_str("(selection: Range(lo: 90000.0, hi: 99999.0))").unwrap();
         assert!(far.selection(&head, |_| None).unwrap_err().contains("no voxel"));
@@ -457,14 +465,21 @@ mod tests {
         .unwrap();
         assert_eq!(planes.parts(&head).unwrap().len(), 4);
         // Joints, groups and densities: checked, and their part indices against the cuts.
-        let layout = |tail: &str| ron::from_str::<ExplodeSpec>(&format!("(selection: Range(lo: 300.0, hi: 4000.0), parts: Grid((2, 1, 2)), {tail})"));
+        let layout = |tail: &str| {
+            ron::from_str::<ExplodeSpec>(&format!("(selection: Range(lo: 300.0, hi: 4000.0), parts: Grid((2, 1, 2)), {tail})"))
+        };
         let ok = layout("groups: [[0, 1]], density: [(2, 3.0)], joints: [(kind: hinge, part: 3, to: Some(2), anchor: (0.0, 0.0, 0.0), axis: (0.0, 0.0, 1.0), limits: Some((0.0, 90.0)))]").unwrap();
         ok.validate(1).unwrap();
         assert_eq!(ok.parts(&head).unwrap().len(), 4);
         let j = ok.joints[0].joint(|i| Entity::from_raw_u32(i as u32 + 10).unwrap());
-        assert_eq!((j.kind, j.part.index_u32(), j.to.map(|e| e.index_u32()), j.limits), (JointKind::Hinge, 13, Some(12), Some((0.0, 90.0))));
+        assert_eq!(
+            (j.kind, j.part.index_u32(), j.to.map(|e| e.index_u32()), j.limits),
+            (JointKind::Hinge, 13, Some(12), Some((0.0, 90.0)))
+        );
         assert_eq!(JointSpec::of(&j, |e| Some(e.index_u32() as usize - 10)).as_ref(), Some(&ok.joints[0]), "saved as loaded");
-        let e = |tail: &str| layout(tail).map_err(|e| e.to_string()).and_then(|s| s.validate(1).and_then(|_| s.parts(&head).map(|_| ()))).unwrap_err();
+        let e = |tail: &str| {
+            layout(tail).map_err(|e| e.to_string()).and_then(|s| s.validate(1).and_then(|_| s.parts(&head).map(|_| ()))).unwrap_err()
+        };
         assert!(e("joints: [(kind: slider, part: 9, anchor: (0.0, 0.0, 0.0))]").contains("jointed part 9"));
         assert!(e("joints: [(kind: ball, part: 1, to: Some(1), anchor: (0.0, 0.0, 0.0))]").contains("joint 0: part 1 is joined to itself"));
         assert!(e("joints: [(kind: hinge, part: 1, anchor: (0.0, 0.0, 0.0), axis: (0.0, 0.0, 0.0))]").contains("joint 0"));

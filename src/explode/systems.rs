@@ -46,7 +46,19 @@ impl Plugin for ExplodePlugin {
             .add_systems(ExplodeStep, apply_forces.before(PhysicsSet::SyncBackend))
             .init_resource::<super::edit::ExplodeEdits>()
             .init_resource::<super::edit::CurrentSpecs>()
-            .add_systems(Update, (super::edit::apply_edits, ensure_parts, group_joints, build_joints, update_points, sync_bodies, super::edit::update_current_specs).chain())
+            .add_systems(
+                Update,
+                (
+                    super::edit::apply_edits,
+                    ensure_parts,
+                    group_joints,
+                    build_joints,
+                    update_points,
+                    sync_bodies,
+                    super::edit::update_current_specs,
+                )
+                    .chain(),
+            )
             .add_systems(PostUpdate, exploded_regions.in_set(RegionSystems::Modify).before(crate::windows::systems::window_regions));
     }
 }
@@ -176,7 +188,10 @@ pub fn sync_bodies(
 #[allow(clippy::type_complexity)]
 pub fn update_points(
     mut commands: Commands,
-    datasets: Query<(Entity, &Dataset, &Exploded, Option<&ExplosionPoints>), Or<(Changed<Exploded>, Changed<Dataset>, Without<ExplosionPoints>)>>,
+    datasets: Query<
+        (Entity, &Dataset, &Exploded, Option<&ExplosionPoints>),
+        Or<(Changed<Exploded>, Changed<Dataset>, Without<ExplosionPoints>)>,
+    >,
 ) {
     for (e, d, x, old) in &datasets {
         let points = match &x.selection {
@@ -187,8 +202,9 @@ pub fn update_points(
                     crate::region::Lookup::Transfer(tf) => Some(Lut::for_volume(tf, v)),
                     crate::region::Lookup::Labels(_) => None,
                 };
-                let visible =
-                    |lo: u16, hi: u16| lut.as_ref().is_none_or(|l| l.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0);
+                let visible = |lo: u16, hi: u16| {
+                    lut.as_ref().is_none_or(|l| l.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0)
+                };
                 explosion_points(&v.grid, v.bricks(), sel.bricks(), visible, x.max_points)
             }
             None => Vec::new(),
@@ -316,7 +332,8 @@ pub fn exploded_regions(
         }
         if x.selection.is_some() {
             scene.appearances.push(weighted(x.selection_look.as_ref().unwrap_or(&own), Keep::Selected));
-            regions.push(Region { appearance: scene.appearances.len() - 1, ..Region::dataset(grid, global.affine(), &d.clip, volume_index) });
+            regions
+                .push(Region { appearance: scene.appearances.len() - 1, ..Region::dataset(grid, global.affine(), &d.clip, volume_index) });
         }
         scene.regions.splice(region_index..=region_index, regions);
         changed = true;

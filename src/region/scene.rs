@@ -69,7 +69,10 @@ impl RenderScene {
     /// (the GPU atlas holds all of these).
     pub fn all_volumes(&self) -> Vec<Arc<Volume>> {
         let mut all = self.volumes.clone();
-        let extra = self.appearances.iter().flat_map(|a| a.segmentation.as_ref().map(|s| &s.labels).into_iter().chain(a.selection.as_ref().map(|w| &w.volume)));
+        let extra = self
+            .appearances
+            .iter()
+            .flat_map(|a| a.segmentation.as_ref().map(|s| &s.labels).into_iter().chain(a.selection.as_ref().map(|w| &w.volume)));
         for v in extra {
             if !all.iter().any(|a| Arc::ptr_eq(a, v)) {
                 all.push(v.clone());

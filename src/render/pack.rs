@@ -382,8 +382,11 @@ pub fn overlaps(prepared: &[PreparedRegion]) -> Overlaps {
     let visible: Vec<_> = prepared.iter().map(|p| p.visible_part()).collect();
     let dvr_like = |p: &PreparedRegion| p.objects.is_none() && matches!(p.mode, Mode::Dvr | Mode::GradientDvr | Mode::Context);
     let n = prepared.len();
-    let pairs: Vec<(usize, usize)> =
-        visible.iter().enumerate().flat_map(|(a, va)| (a + 1..n).filter(|&b| meet(&[va, prepared[b].region])).map(move |b| (a, b))).collect();
+    let pairs: Vec<(usize, usize)> = visible
+        .iter()
+        .enumerate()
+        .flat_map(|(a, va)| (a + 1..n).filter(|&b| meet(&[va, prepared[b].region])).map(move |b| (a, b)))
+        .collect();
     let mut out = Overlaps::default();
     for &(a, b) in &pairs {
         let third = (0..n).any(|c| c != a && c != b && meet(&[prepared[a].region, prepared[b].region, prepared[c].region]));

@@ -87,7 +87,12 @@ pub fn load_datasets_with(scene: &SceneFile, base: &Path, progress: Option<Progr
 }
 
 /// The exploded view a spec describes for dataset `i`.
-pub fn explosion(spec: &crate::explode::spec::ExplodeSpec, datasets: &[LoadedDataset], i: usize, base: &Path) -> Result<crate::explode::spec::LoadedExplode, String> {
+pub fn explosion(
+    spec: &crate::explode::spec::ExplodeSpec,
+    datasets: &[LoadedDataset],
+    i: usize,
+    base: &Path,
+) -> Result<crate::explode::spec::LoadedExplode, String> {
     let data = &datasets[i].volume;
     let label = |d: usize| {
         let ds = datasets.get(d)?;

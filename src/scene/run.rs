@@ -27,7 +27,11 @@ pub struct RunOptions {
 
 /// The frames to capture (one "default" frame when the file lists none).
 fn frames(scene: &SceneFile) -> Vec<FrameSpec> {
-    if scene.frames.is_empty() { vec![FrameSpec { name: "default".into(), camera: None, set: Vec::new(), settle: None }] } else { scene.frames.clone() }
+    if scene.frames.is_empty() {
+        vec![FrameSpec { name: "default".into(), camera: None, set: Vec::new(), settle: None }]
+    } else {
+        scene.frames.clone()
+    }
 }
 
 /// A file-name-safe version of a frame name.

@@ -19,7 +19,7 @@ use super::lenses::viewport_logical;
 use super::orbit::{OrbitCamera, PointerInViewport};
 use super::{AppState, MainCamera};
 use crate::dataset::Dataset;
-use crate::explode::edit::{Edit, ExplodeEdits, Splitter, SplitHistory};
+use crate::explode::edit::{Edit, ExplodeEdits, SplitHistory, Splitter};
 use crate::explode::spec::{ExplodeSpec, PartsSpec, SelectionSpec};
 use crate::explode::splitters::ScreenAxis;
 use crate::explode::{Exploded, JointKind, Part, PartJoint};
@@ -242,14 +242,21 @@ pub fn explode_panel(
 }
 
 /// The form that explodes a dataset.
-fn explode_form(ui: &mut egui::Ui, s: &mut ExplodeUi, edits: &mut ExplodeEdits, dataset: Entity, datasets: &[(Entity, &Dataset, Option<&SplitHistory>)]) {
+fn explode_form(
+    ui: &mut egui::Ui,
+    s: &mut ExplodeUi,
+    edits: &mut ExplodeEdits,
+    dataset: Entity,
+    datasets: &[(Entity, &Dataset, Option<&SplitHistory>)],
+) {
     ui.label("Selection (the focus):");
     ui.horizontal(|ui| {
         ui.radio_value(&mut s.use_labels, true, "labels");
         ui.radio_value(&mut s.use_labels, false, "value range");
     });
     if s.use_labels {
-        let label_sets: Vec<(usize, &Dataset)> = datasets.iter().enumerate().filter(|(_, d)| d.1.labels.is_some()).map(|(i, d)| (i, d.1)).collect();
+        let label_sets: Vec<(usize, &Dataset)> =
+            datasets.iter().enumerate().filter(|(_, d)| d.1.labels.is_some()).map(|(i, d)| (i, d.1)).collect();
         if label_sets.is_empty() {
             ui.label("(no label dataset loaded: use a value range)");
         }
@@ -381,16 +388,19 @@ fn joints_form(
                 ui.selectable_value(&mut s.joint_kind, k, k.name());
             }
         });
-        egui::ComboBox::from_label("to")
-            .selected_text(s.joint_to.map_or("the world".to_string(), |t| format!("part {t}")))
-            .show_ui(ui, |ui| {
+        egui::ComboBox::from_label("to").selected_text(s.joint_to.map_or("the world".to_string(), |t| format!("part {t}"))).show_ui(
+            ui,
+            |ui| {
                 ui.selectable_value(&mut s.joint_to, None, "the world");
                 for i in 0..list.len() {
                     ui.selectable_value(&mut s.joint_to, Some(i), format!("part {i}"));
                 }
-            });
+            },
+        );
         egui::ComboBox::from_label("axis").selected_text(format!("{:?}", s.joint_axis)).show_ui(ui, |ui| {
-            for a in [AxisChoice::ScreenVertical, AxisChoice::ScreenHorizontal, AxisChoice::View, AxisChoice::X, AxisChoice::Y, AxisChoice::Z] {
+            for a in
+                [AxisChoice::ScreenVertical, AxisChoice::ScreenHorizontal, AxisChoice::View, AxisChoice::X, AxisChoice::Y, AxisChoice::Z]
+            {
                 ui.selectable_value(&mut s.joint_axis, a, format!("{a:?}"));
             }
         });

@@ -301,7 +301,11 @@ fn shortcuts(
 
 /// Opens the exploded view's panel when a dataset is exploded (a scene that explodes
 /// one, or the panel's own Explode) and selects it.
-fn open_explode_panel(added: Query<Entity, Added<crate::explode::Exploded>>, datasets: Query<Entity, With<crate::dataset::Dataset>>, mut state: ResMut<AppState>) {
+fn open_explode_panel(
+    added: Query<Entity, Added<crate::explode::Exploded>>,
+    datasets: Query<Entity, With<crate::dataset::Dataset>>,
+    mut state: ResMut<AppState>,
+) {
     let Some(e) = added.iter().min() else { return };
     let mut all: Vec<Entity> = datasets.iter().collect();
     all.sort();

@@ -58,10 +58,26 @@ fn splitters_cut_the_parts_where_they_are_and_undo_puts_them_back() {
     split(&mut app, Splitter::Depth { camera, ray: camera.ray(56.0, 64.0, 128, 128) }).unwrap();
     let p = parts(&mut app);
     assert_eq!(p.len(), 3);
-    let ys = |part: &Part| part.rest.vertices.iter().map(|v| v.y).fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), y| (a.min(y), b.max(y)));
-    let cut: Vec<f32> = p.iter().map(|(_, part)| ys(part)).filter(|(lo, hi)| *lo > -119.0 || *hi < 119.0).flat_map(|(lo, hi)| [lo, hi]).filter(|y| y.abs() < 119.0).collect();
+    let ys =
+        |part: &Part| part.rest.vertices.iter().map(|v| v.y).fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), y| (a.min(y), b.max(y)));
+    let cut: Vec<f32> = p
+        .iter()
+        .map(|(_, part)| ys(part))
+        .filter(|(lo, hi)| *lo > -119.0 || *hi < 119.0)
+        .flat_map(|(lo, hi)| [lo, hi])
+        .filter(|y| y.abs() < 119.0)
+        .collect();
     assert!(cut.len() == 2 && (cut[0] - cut[1]).abs() < 1e-3 && cut[0].abs() < 100.0, "one depth, inside the head: {cut:?}");
-    assert_eq!(p.iter().filter(|(_, part)| { let (lo, hi) = ys(part); lo < -119.0 && hi > 119.0 }).count(), 1, "the other half is whole");
+    assert_eq!(
+        p.iter()
+            .filter(|(_, part)| {
+                let (lo, hi) = ys(part);
+                lo < -119.0 && hi > 119.0
+            })
+            .count(),
+        1,
+        "the other half is whole"
+    );
     // A line across the whole view splits every part it crosses: a horizontal segment
     // through the middle cuts all three at z = 0.
     split(&mut app, Splitter::Line { camera, a: Vec2::new(2.0, 64.0), b: Vec2::new(126.0, 64.0), size: UVec2::splat(128) }).unwrap();
@@ -90,7 +106,11 @@ fn splits_keep_joints_flags_and_motion_and_the_state_saves_as_a_spec() {
     app.update();
     step(app.world_mut(), 60);
     let moved = *app.world().get::<Transform>(whole).unwrap();
-    apply(app.world_mut(), Edit::Split { dataset, splitter: Splitter::Axis { camera, ray: camera.ray(64.0, 64.0, 128, 128), axis: ScreenAxis::Vertical } }).unwrap();
+    apply(
+        app.world_mut(),
+        Edit::Split { dataset, splitter: Splitter::Axis { camera, ray: camera.ray(64.0, 64.0, 128, 128), axis: ScreenAxis::Vertical } },
+    )
+    .unwrap();
     let p = parts(&mut app);
     assert_eq!(p.len(), 2);
     for (e, part) in &p {

@@ -38,7 +38,8 @@ fn settled(data: &Dataset, loaded: &LoadedExplode) -> Vec<Transform> {
     }
     app.update();
     step(app.world_mut(), 300);
-    let mut parts: Vec<(Entity, Transform)> = app.world_mut().query_filtered::<(Entity, &Transform), With<Part>>().iter(app.world()).map(|(e, t)| (e, *t)).collect();
+    let mut parts: Vec<(Entity, Transform)> =
+        app.world_mut().query_filtered::<(Entity, &Transform), With<Part>>().iter(app.world()).map(|(e, t)| (e, *t)).collect();
     parts.sort_by_key(|p| p.0);
     parts.into_iter().map(|p| p.1).collect()
 }
@@ -54,7 +55,10 @@ pub fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> Result<
     // Each count's explosion and its settled motions.
     let mut configs: Vec<(LoadedExplode, Vec<Transform>)> = Vec::new();
     for grid in GRIDS {
-        let spec = ExplodeSpec { parts: PartsSpec::Grid(grid), ..ExplodeSpec::around(SelectionSpec::Labels { dataset: 1, ids: ids.iter().copied().collect() }) };
+        let spec = ExplodeSpec {
+            parts: PartsSpec::Grid(grid),
+            ..ExplodeSpec::around(SelectionSpec::Labels { dataset: 1, ids: ids.iter().copied().collect() })
+        };
         let loaded = LoadedExplode { exploded: spec.exploded(selection.clone(), Some(vessels.clone())), parts: spec.parts(&ct)?, spec };
         let motions = settled(&data, &loaded);
         configs.push((loaded, motions));

@@ -257,7 +257,8 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         .split_once('x')
         .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
         .ok_or_else(|| format!("size '{}' is not WIDTHxHEIGHT", args.size))?;
-    let all = !(args.skipping || args.termination || args.modes || args.lenses || args.context || args.twolevel || args.windows || args.explode);
+    let all =
+        !(args.skipping || args.termination || args.modes || args.lenses || args.context || args.twolevel || args.windows || args.explode);
     let off = Offscreen::new(w, h, |app| {
         app.add_plugins(FocalPlugins);
     })?;

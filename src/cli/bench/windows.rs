@@ -53,7 +53,8 @@ fn cutaway(content: Vec<Content>) -> Placed {
 const CUTAWAY: Vec3 = Vec3::new(-45.0, 62.0, 42.0);
 
 /// Four places on the skin the oblique view sees, apart from each other.
-const ON_THE_SKIN: [Vec3; 4] = [Vec3::new(-65.0, 23.0, 51.0), Vec3::new(-5.0, 76.0, 62.0), Vec3::new(-70.0, 43.0, 2.0), Vec3::new(-23.0, 94.0, 6.0)];
+const ON_THE_SKIN: [Vec3; 4] =
+    [Vec3::new(-65.0, 23.0, 51.0), Vec3::new(-5.0, 76.0, 62.0), Vec3::new(-70.0, 43.0, 2.0), Vec3::new(-23.0, 94.0, 6.0)];
 
 /// Where the calcifications are (`phantom::head`), the magnifier's source.
 const CALCIFICATIONS: Vec3 = Vec3::new(28.0, 18.0, 22.0);
@@ -96,7 +97,10 @@ pub fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> Result<
             2 => windows.push(cutaway(content(&bone))),
             3 => {
                 for c in ON_THE_SKIN {
-                    windows.push(Placed { window: VolumeWindow { clip: true, ..VolumeWindow::new(Vec3::splat(44.0), content(&skin)) }, center: c });
+                    windows.push(Placed {
+                        window: VolumeWindow { clip: true, ..VolumeWindow::new(Vec3::splat(44.0), content(&skin)) },
+                        center: c,
+                    });
                 }
             }
             4 => {
