@@ -16,6 +16,8 @@ use focal::volume::{SelectionVolume, Volume};
 mod edit;
 #[path = "explode/joints.rs"]
 mod joints;
+#[path = "explode/paint.rs"]
+mod paint;
 
 fn app() -> App {
     let mut app = App::new();

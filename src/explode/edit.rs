@@ -1,5 +1,6 @@
 //! Editing exploded views: exploding a dataset around a selection, the three splitters
-//! of section 3.1 applied to the parts where they are now, and undoing splits.
+//! of section 3.1 applied to the parts where they are now, and undoing splits; painting
+//! the selection with the brush, undoing strokes, smoothing it.
 //!
 //! The app's panel and viewport tools queue [`Edit`]s in [`ExplodeEdits`];
 //! [`apply_edits`] (an exclusive system) carries them out on the world, so headless
@@ -12,9 +13,11 @@
 //! with the CPU reference's first hit.
 
 use bevy::prelude::*;
+use glam::Affine3A;
 
 use super::components::{ExplodeSource, Exploded, Part};
 use super::joints::{GroupJoint, PartJoint};
+use super::paint::{Brush, Stroke, paint};
 use super::parts::Polyhedron;
 use super::spec::{ExplodeSpec, LoadedExplode, PartsSpec, PlaneSpec, replace_explosion};
 use super::splitters::{ScreenAxis, axis_plane, depth_plane, in_part_frame, line_plane, segment_crosses};
@@ -62,6 +65,23 @@ pub enum Edit {
     Pick {
         dataset: Entity,
         ray: Ray,
+    },
+    /// Dabs `brush` on the selection at the first visible point of `dataset` under
+    /// `ray` ([`super::paint`]); `new_stroke` starts a stroke (one step of undo).
+    Paint {
+        dataset: Entity,
+        ray: Ray,
+        brush: Brush,
+        new_stroke: bool,
+    },
+    /// Takes back the last stroke painted on `dataset`'s selection.
+    UndoStroke {
+        dataset: Entity,
+    },
+    /// Smooths `dataset`'s selection with `passes` binomial passes (before the strokes).
+    Smooth {
+        dataset: Entity,
+        passes: u32,
     },
 }
 
@@ -136,11 +156,22 @@ pub fn apply(world: &mut World, edit: Edit) -> Result<(), String> {
                 Some(Picked { part, world: hit, rest: to_world.inverse().transform_point3(hit), to_world });
             Ok(())
         }
+        Edit::Paint { dataset, ray, brush, new_stroke } => paint_at(world, dataset, ray, brush, new_stroke),
+        Edit::UndoStroke { dataset } => {
+            let mut source = world.get_mut::<ExplodeSource>(dataset).ok_or("the dataset is not exploded")?;
+            source.0.paint.pop().ok_or("no stroke to undo")?;
+            reselect(world, dataset)
+        }
+        Edit::Smooth { dataset, passes } => {
+            world.get_mut::<ExplodeSource>(dataset).ok_or("the dataset is not exploded")?.0.smooth = passes;
+            reselect(world, dataset)
+        }
     }
 }
 
-/// Explodes `dataset` as `spec` says, at rest.
-fn explode(world: &mut World, dataset: Entity, spec: &ExplodeSpec) -> Result<(), String> {
+/// The selection `spec` asks for on `dataset` (its labels from the datasets in entity
+/// order).
+fn selection_of(world: &mut World, dataset: Entity, spec: &ExplodeSpec) -> Result<crate::volume::Volume, String> {
     let mut datasets: Vec<(Entity, Dataset)> = world.query::<(Entity, &Dataset)>().iter(world).map(|(e, d)| (e, d.clone())).collect();
     datasets.sort_by_key(|d| d.0);
     spec.validate(datasets.len())?;
@@ -149,7 +180,51 @@ fn explode(world: &mut World, dataset: Entity, spec: &ExplodeSpec) -> Result<(),
         let (_, d) = datasets.get(i)?;
         Some(LabelVolume { volume: (*d.volume).clone(), table: (**d.labels.as_ref()?).clone() })
     };
-    let selection = spec.selection(&data, label)?;
+    spec.selection(&data, label)
+}
+
+/// Recomputes `dataset`'s selection from its spec (after its strokes or smoothing
+/// changed); the parts stay as they are.
+fn reselect(world: &mut World, dataset: Entity) -> Result<(), String> {
+    let spec = world.get::<ExplodeSource>(dataset).ok_or("the dataset is not exploded")?.0.clone();
+    let selection = selection_of(world, dataset, &spec)?;
+    let mut x = world.get_mut::<Exploded>(dataset).ok_or("the dataset is not exploded")?;
+    x.selection = Some(std::sync::Arc::new(selection));
+    Ok(())
+}
+
+/// One dab of the brush (see [`Edit::Paint`]): at the data point under the first
+/// visible point of the scene on `ray` (a part's or the selection's region of
+/// `dataset`, carried back to the dataset's frame by that region's map), added to the
+/// spec's last stroke and painted on the selection.
+fn paint_at(world: &mut World, dataset: Entity, ray: Ray, brush: Brush, new_stroke: bool) -> Result<(), String> {
+    let regions = world.resource::<SceneRegions>();
+    let hit = crate::reference::pick(&regions.scene, ray)?.ok_or("nothing visible under the brush")?;
+    let region = regions.scene.regions.get(hit.region).ok_or("nothing visible under the brush")?;
+    if regions.datasets.get(region.volume) != Some(&dataset) {
+        return Err("the brush is over another dataset".into());
+    }
+    let shown = regions.scene.volumes.get(region.volume).ok_or("nothing visible under the brush")?;
+    let at = shown.grid.index_to_world().transform_point3(region.world_to_voxel.transform_point3(hit.position));
+    let mut source = world.get_mut::<ExplodeSource>(dataset).ok_or("the dataset is not exploded")?;
+    let strokes = &mut source.0.paint;
+    if new_stroke || strokes.last().is_none_or(|s| s.brush() != brush) {
+        strokes.push(Stroke::new(brush));
+    }
+    if let Some(s) = strokes.last_mut() {
+        s.dabs.push((at.x, at.y, at.z));
+    }
+    let mut x = world.get_mut::<Exploded>(dataset).ok_or("the dataset is not exploded")?;
+    let selection = x.selection.as_ref().ok_or("the exploded view has no selection")?;
+    let painted = paint(selection, brush, [at])?;
+    x.selection = Some(std::sync::Arc::new(painted.volume));
+    Ok(())
+}
+
+/// Explodes `dataset` as `spec` says, at rest.
+fn explode(world: &mut World, dataset: Entity, spec: &ExplodeSpec) -> Result<(), String> {
+    let selection = selection_of(world, dataset, spec)?;
+    let data = world.get::<Dataset>(dataset).map(|d| d.volume.clone()).ok_or("no such dataset")?;
     let old = world.get::<Exploded>(dataset).cloned();
     let mut exploded = spec.exploded(selection, None);
     // Re-exploding keeps the look and the viewing settings.
@@ -177,8 +252,6 @@ fn parts_of(world: &mut World, dataset: Entity) -> Vec<(Entity, Part, Transform)
 fn dataset_to_world(world: &World, dataset: Entity) -> Affine3A {
     world.get::<GlobalTransform>(dataset).map_or(Affine3A::IDENTITY, |g| g.affine())
 }
-
-use glam::Affine3A;
 
 /// The first visible background point on `ray` (world), picked by the CPU reference in
 /// the scene without the selection's regions.

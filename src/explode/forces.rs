@@ -100,11 +100,17 @@ pub struct Wrench {
 impl Wrench {
     /// The sum of `pushes` as a force and a torque about `center`.
     pub fn about(center: Vec3, pushes: impl IntoIterator<Item = Push>) -> Wrench {
-        pushes.into_iter().fold(Wrench::default(), |w, p| Wrench {
-            force: w.force + p.force,
-            torque: w.torque + (p.at - center).cross(p.force),
-            ..w
-        })
+        let mut w = Wrench::default();
+        for p in pushes {
+            w.add(center, p);
+        }
+        w
+    }
+
+    /// Adds `p` to the force and its moment about `center` to the torque.
+    pub fn add(&mut self, center: Vec3, p: Push) {
+        self.force += p.force;
+        self.torque += (p.at - center).cross(p.force);
     }
 }
 
@@ -209,42 +215,42 @@ pub struct PartNow<'a> {
 /// Every force on one part (equations 1–5) as a force and a torque about its centre of
 /// mass.
 pub fn part_wrench(part: &PartNow, around: &Surroundings, c: &Coefficients, scale: Scale) -> Wrench {
+    let mut w = Wrench::default();
+    let mut add = |p: Push| w.add(part.center_of_mass, p);
     let n = part.rest.vertices.len().max(1) as f32;
-    let returns = part.rest.vertices.iter().map(|v| {
+    for v in &part.rest.vertices {
         let now = part.to_world.transform_point3(*v);
-        Push { force: return_force(now, *v, c.returning, scale) / n, at: now }
-    });
-    let mut pushes: Vec<Push> = returns.collect();
+        add(Push { force: return_force(now, *v, c.returning, scale) / n, at: now });
+    }
     let mut in_view = 0.0;
     let total: f32 = around.points.iter().map(|p| p.weight).sum();
+    let rest_center = part.rest.centroid();
     if total > 0.0 && c.degree != 0.0 {
         // Closest points in the part's rest frame (the motion is rigid: distances keep).
         let (m, back) = (part.to_world, part.to_world.inverse());
-        let rest_center = part.rest.centroid();
         let center = m.transform_point3(rest_center);
+        let eye_rest = around.eye.map(|eye| back.transform_point3(eye));
         for p in around.points {
-            let x = m.transform_point3(part.rest.closest_point(back.transform_point3(p.position)));
-            pushes.push(Push { force: explosion_force(p.position, x, c.explosion(), scale) * (p.weight / total), at: x });
-            if let Some(eye) = around.eye {
-                let (eye_rest, dir_rest) = (back.transform_point3(eye), back.transform_vector3(p.position - eye));
-                let (dir, d, at) = off_ray(eye_rest, dir_rest, part.rest, rest_center, scale);
+            let share = p.weight / total;
+            let point_rest = back.transform_point3(p.position);
+            let x = m.transform_point3(part.rest.closest_point(point_rest));
+            add(Push { force: explosion_force(p.position, x, c.explosion(), scale) * share, at: x });
+            if let Some(eye_rest) = eye_rest {
+                let (dir, d, at) = off_ray(eye_rest, point_rest - eye_rest, part.rest, rest_center, scale);
                 let (dir, at) = (m.transform_vector3(dir), m.transform_point3(at));
-                in_view += p.weight / total / (1.0 + d);
-                pushes.push(Push { force: viewing_force(dir, d, c.viewing(), scale) * (p.weight / total), at });
+                in_view += share / (1.0 + d);
+                add(Push { force: viewing_force(dir, d, c.viewing(), scale) * share, at });
             }
         }
         let parts = around.centers.len().max(1) as f32;
         for (j, other) in around.centers.iter().enumerate() {
             if j != part.index {
-                pushes.push(Push { force: spacing_force(center, *other, c.spacing(), scale) / parts, at: center });
+                add(Push { force: spacing_force(center, *other, c.spacing(), scale) / parts, at: center });
             }
         }
     }
-    let mut w = Wrench::about(part.center_of_mass, pushes);
     let (_, rotation, _) = part.to_world.to_scale_rotation_translation();
-    let rest_center = part.rest.centroid();
-    let radius = part.rest.vertices.iter().map(|v| v.distance(rest_center)).fold(0.0, f32::max);
-    w.torque += return_torque(rotation, radius, c.returning, scale);
+    w.torque += return_torque(rotation, part.rest.radius(), c.returning, scale);
     w.in_view = in_view;
     w
 }

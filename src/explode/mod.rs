@@ -4,6 +4,7 @@
 //! while the parts stay recognisable around it.
 //!
 //! - [`parts`]: convex parts and splitting them (section 3.1);
+//! - [`paint`]: painting the selection with a volumetric brush;
 //! - [`splitters`]: the axis, depth and line splitters' planes in the current view;
 //! - [`forces`]: the return, explosion, viewing and spacing forces (section 3.2,
 //!   equations 1–5).
@@ -22,6 +23,7 @@ pub mod components;
 pub mod edit;
 pub mod forces;
 pub mod joints;
+pub mod paint;
 pub mod parts;
 pub mod points;
 pub mod regions;

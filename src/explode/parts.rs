@@ -13,7 +13,8 @@ use glam::Vec3;
 
 use crate::region::{Plane, bounding_planes, has_volume, vertices};
 
-/// A convex polyhedron in a dataset's own frame.
+/// A convex polyhedron in a dataset's own frame, with what the forces ask of it every
+/// step (its centroid, volume and radius, each face's plane) computed once.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Polyhedron {
     /// Half-spaces (normals out), only those that bound it.
@@ -22,6 +23,13 @@ pub struct Polyhedron {
     pub vertices: Vec<Vec3>,
     /// Each face's vertices in order around it (one face per plane).
     pub faces: Vec<Vec<Vec3>>,
+    /// The plane of each face (unit normal out).
+    face_planes: Vec<Plane>,
+    /// Each face's edges: start, direction to the end, 1 / its squared length.
+    edges: Vec<Vec<(Vec3, Vec3, f32)>>,
+    centroid: Vec3,
+    volume: f32,
+    radius: f32,
 }
 
 impl Polyhedron {
@@ -32,8 +40,29 @@ impl Polyhedron {
         }
         let planes = bounding_planes(planes);
         let vertices = dedup(vertices(&planes));
-        let faces = faces(&planes, &vertices);
-        Some(Polyhedron { planes, vertices, faces })
+        Some(Polyhedron::with(planes, vertices))
+    }
+
+    /// The polyhedron of `planes` with `vertices`: its faces and measures.
+    fn with(planes: Vec<Plane>, vertices: Vec<Vec3>) -> Polyhedron {
+        let (face_planes, faces): (Vec<Plane>, Vec<Vec<Vec3>>) = faces(&planes, &vertices).into_iter().unzip();
+        let edges = faces
+            .iter()
+            .map(|f| {
+                (0..f.len())
+                    .map(|i| {
+                        let (a, b) = (f[i], f[(i + 1) % f.len()]);
+                        (a, b - a, 1.0 / (b - a).length_squared().max(1e-20))
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut p = Polyhedron { planes, vertices, faces, face_planes, edges, centroid: Vec3::ZERO, volume: 0.0, radius: 0.0 };
+        let (volume, centroid) = p.volume_and_centroid();
+        p.volume = volume;
+        p.centroid = centroid;
+        p.radius = p.vertices.iter().map(|v| v.distance(centroid)).fold(0.0, f32::max);
+        p
     }
 
     /// The axis-aligned box `[lo, hi]`.
@@ -46,8 +75,7 @@ impl Polyhedron {
                 Vec3::new(if c & 1 == 0 { lo.x } else { hi.x }, if c & 2 == 0 { lo.y } else { hi.y }, if c & 4 == 0 { lo.z } else { hi.z })
             })
             .collect();
-        let faces = faces(&planes, &vertices);
-        Polyhedron { planes, vertices, faces }
+        Polyhedron::with(planes, vertices)
     }
 
     /// The two halves on either side of `plane` (the one `plane` keeps first), or `None`
@@ -67,10 +95,11 @@ impl Polyhedron {
         Some((with(plane)?, with(plane.flipped())?))
     }
 
-    /// The centroid of the solid (tetrahedra from the vertex mean to each face).
-    pub fn centroid(&self) -> Vec3 {
+    /// The volume and centroid of the solid (tetrahedra from the vertex mean to each
+    /// face).
+    fn volume_and_centroid(&self) -> (f32, Vec3) {
+        let apex = self.vertex_mean().as_dvec3();
         let (volume, moment) = self.faces.iter().fold((0.0f64, glam::DVec3::ZERO), |(v, m), face| {
-            let apex = self.vertex_mean().as_dvec3();
             let (a, fan) = (face[0].as_dvec3(), &face[1..]);
             fan.windows(2).fold((v, m), |(v, m), e| {
                 let (b, c) = (e[0].as_dvec3(), e[1].as_dvec3());
@@ -78,22 +107,22 @@ impl Polyhedron {
                 (v + vol, m + (apex + a + b + c) * 0.25 * vol)
             })
         });
-        if volume <= 0.0 { self.vertex_mean() } else { (moment / volume).as_vec3() }
+        (volume as f32, if volume <= 0.0 { self.vertex_mean() } else { (moment / volume).as_vec3() })
+    }
+
+    /// The centroid of the solid.
+    pub fn centroid(&self) -> Vec3 {
+        self.centroid
     }
 
     /// The volume of the solid.
     pub fn volume(&self) -> f32 {
-        let apex = self.vertex_mean().as_dvec3();
-        self.faces
-            .iter()
-            .map(|face| {
-                let a = face[0].as_dvec3();
-                face[1..]
-                    .windows(2)
-                    .map(|e| (a - apex).dot((e[0].as_dvec3() - apex).cross(e[1].as_dvec3() - apex)).abs() / 6.0)
-                    .sum::<f64>()
-            })
-            .sum::<f64>() as f32
+        self.volume
+    }
+
+    /// The distance of the farthest vertex from the centroid.
+    pub fn radius(&self) -> f32 {
+        self.radius
     }
 
     /// The mean of the vertices.
@@ -115,36 +144,39 @@ impl Polyhedron {
         if self.contains(p) {
             return p;
         }
-        let mut best = self.vertices.first().copied().unwrap_or(p);
-        let mut consider = |q: Vec3| {
-            if q.distance_squared(p) < best.distance_squared(p) {
-                best = q;
+        // A face's foot that lies in the polyhedron is the answer: the polyhedron lies in
+        // the face's half-space, so no point of it is nearer than that plane.
+        for plane in &self.face_planes {
+            let d = plane.distance(p);
+            if d > 0.0 {
+                let q = p - plane.normal * d;
+                if self.contains(q) {
+                    return q;
+                }
             }
-        };
-        for face in &self.faces {
-            let n = (face[1] - face[0]).cross(face[2] - face[0]).normalize_or_zero();
-            let d = (p - face[0]).dot(n);
-            if d <= 0.0 {
+        }
+        // Otherwise it lies on an edge (or a vertex) of a face that faces p.
+        let mut best = self.vertices.first().copied().unwrap_or(p);
+        let mut best_d = best.distance_squared(p);
+        for (edges, plane) in self.edges.iter().zip(&self.face_planes) {
+            if plane.distance(p) <= 0.0 {
                 continue;
             }
-            let q = p - n * d;
-            if self.contains(q) {
-                consider(q);
-            }
-            for (i, a) in face.iter().enumerate() {
-                let b = face[(i + 1) % face.len()];
-                let ab = b - *a;
-                let s = ((p - *a).dot(ab) / ab.length_squared().max(1e-20)).clamp(0.0, 1.0);
-                consider(*a + ab * s);
+            for &(a, ab, inv) in edges {
+                let q = a + ab * ((p - a).dot(ab) * inv).clamp(0.0, 1.0);
+                let d = q.distance_squared(p);
+                if d < best_d {
+                    (best, best_d) = (q, d);
+                }
             }
         }
         best
     }
 }
 
-/// Each plane's face: the vertices on it in order around it (planes with fewer than
-/// three vertices on them have none).
-fn faces(planes: &[Plane], vertices: &[Vec3]) -> Vec<Vec<Vec3>> {
+/// Each plane's face: the plane (unit normal) and the vertices on it in order around it
+/// (planes with fewer than three vertices on them have none).
+fn faces(planes: &[Plane], vertices: &[Vec3]) -> Vec<(Plane, Vec<Vec3>)> {
     let scale = vertices.iter().map(|v| v.length()).fold(1.0, f32::max);
     planes
         .iter()
@@ -159,7 +191,8 @@ fn faces(planes: &[Plane], vertices: &[Vec3]) -> Vec<Vec<Vec3>> {
             let angle = |a: &Vec3| (*a - c).dot(w).atan2((*a - c).dot(u));
             let mut sorted = on;
             sorted.sort_by(|a, b| angle(a).total_cmp(&angle(b)));
-            Some(sorted)
+            let n = pl.normal.length().max(1e-30);
+            Some((Plane { normal: pl.normal / n, offset: pl.offset / n }, sorted))
         })
         .collect()
 }

@@ -5,6 +5,7 @@
 //! explode: Some((
 //!     selection: Labels(dataset: 1, ids: [7, 8]),   // or Range(lo: 300.0, hi: 3000.0)
 //!     smooth: 1,                                     // binomial passes on the selection
+//!     paint: [(radius: 8.0, hardness: 0.5, erase: false, dabs: [(10.0, 20.0, 30.0)])],
 //!     look: Some((mode: dvr, preset: Some("ct_vessels"))),
 //!     degree: 1.0, viewing: true, deltas: (0.5, 0.333, 0.1667),
 //!     parts: Grid((2, 1, 2)),                        // or Planes([...]), Parts([[...], ...])
@@ -20,7 +21,9 @@
 //! plane keeps `normal · p ≤ offset` on its first side); `Parts` lists each part's
 //! planes (what the app saves). `fixed` lists parts (in the order the cuts give) that do
 //! not move, `hidden` those that draw nothing, `groups` parts that move as one,
-//! `density` parts heavier or lighter than the default (1). Joints ([`super::joints`])
+//! `density` parts heavier or lighter than the default (1). `paint` lists brush strokes
+//! ([`super::paint`]) painted over the selection after the smoothing (`selection:
+//! Nothing` starts from an empty one). Joints ([`super::joints`])
 //! tie a part to another (`to: Some(index)`) or to the world (`to: None`); anchor and axes
 //! at rest in the dataset's frame (mm), limits in degrees (mm for sliders), `axis2` the
 //! universal joint's second axis.
@@ -34,6 +37,7 @@ use serde::{Deserialize, Serialize};
 use super::components::{Exploded, Part};
 use super::forces::Coefficients;
 use super::joints::{JointKind, PartJoint};
+use super::paint::{Stroke, paint_strokes};
 use super::parts::Polyhedron;
 use super::systems::{spawn_part, volume_polyhedron};
 use crate::region::{Appearance, Plane};
@@ -48,6 +52,9 @@ pub struct ExplodeSpec {
     /// Binomial smoothing passes on the (binary) selection.
     #[serde(default)]
     pub smooth: u32,
+    /// Brush strokes painted over the selection, in order ([`super::paint`]).
+    #[serde(default)]
+    pub paint: Vec<Stroke>,
     /// How the selection is drawn (`None`: as the dataset).
     #[serde(default)]
     pub look: Option<AppearanceSpec>,
@@ -163,6 +170,8 @@ pub enum SelectionSpec {
     Labels { dataset: usize, ids: Vec<u32> },
     /// The dataset's own voxels whose real value lies in `[lo, hi]`.
     Range { lo: f64, hi: f64 },
+    /// Nothing (to paint the selection from scratch).
+    Nothing,
 }
 
 /// How the background is cut into parts.
@@ -208,6 +217,7 @@ impl ExplodeSpec {
         ExplodeSpec {
             selection,
             smooth: 0,
+            paint: Vec::new(),
             look: None,
             degree: 0.0,
             viewing: false,
@@ -236,6 +246,9 @@ impl ExplodeSpec {
             && !(lo.is_finite() && hi.is_finite() && lo <= hi)
         {
             return Err(format!("the selection's range {lo}..{hi} is not a range"));
+        }
+        for (i, stroke) in self.paint.iter().enumerate() {
+            stroke.validate().map_err(|e| format!("paint stroke {i}: {e}"))?;
         }
         let (e, v, s) = self.deltas;
         if ![self.degree, e, v, s].iter().all(|x| x.is_finite() && *x >= 0.0) {
@@ -340,9 +353,10 @@ impl ExplodeSpec {
                 }
                 sel
             }
+            SelectionSpec::Nothing => SelectionVolume::empty(data.grid.clone()),
         };
         let sel = if self.smooth > 0 { binary.smoothed(self.smooth)? } else { binary };
-        Ok(sel.volume)
+        Ok(paint_strokes(sel, &self.paint)?.volume)
     }
 
     /// The component this spec (with the selection and its look loaded) gives.

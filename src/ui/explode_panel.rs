@@ -5,7 +5,8 @@
 //! degree of explosion (the main control), the viewing force, the δ of equation 5; the
 //! splitters (axis, depth, line) as viewport tools; undo; each part's visibility, fixed
 //! state, density and group; joints (pick an anchor on a part in the viewport, choose the
-//! kind, the other end and the axis, add). Edits go through
+//! kind, the other end and the axis, add); the selection's smoothing and brush
+//! ([`super::explode_selection`]). Edits go through
 //! [`crate::explode::edit::ExplodeEdits`].
 
 use std::collections::BTreeSet;
@@ -15,11 +16,14 @@ use bevy::window::PrimaryWindow;
 use bevy_egui::EguiContexts;
 use bevy_egui::egui;
 
+use super::explode_selection::{brush_overlay, selection_section};
 use super::lenses::viewport_logical;
 use super::orbit::{OrbitCamera, PointerInViewport};
 use super::{AppState, MainCamera};
 use crate::dataset::Dataset;
+use crate::explode::components::ExplodeSource;
 use crate::explode::edit::{Edit, ExplodeEdits, SplitHistory, Splitter};
+use crate::explode::paint::Brush;
 use crate::explode::spec::{ExplodeSpec, PartsSpec, SelectionSpec};
 use crate::explode::splitters::ScreenAxis;
 use crate::explode::{Exploded, JointKind, Part, PartJoint};
@@ -36,6 +40,8 @@ pub enum Tool {
     Line,
     /// Pick a joint's anchor (and its part).
     Anchor,
+    /// Paint the selection with the brush (drag; Shift: the other way).
+    Paint,
 }
 
 /// A joint's axis, chosen in the panel.
@@ -68,6 +74,9 @@ pub struct ExplodeUi {
     pub joint_to: Option<usize>,
     pub joint_axis: AxisChoice,
     pub joint_limits: Option<(f32, f32)>,
+    /// The selection brush, and where its last dab was (viewport pixels).
+    pub brush: Brush,
+    last_dab: Option<Vec2>,
 }
 
 impl Default for ExplodeUi {
@@ -84,6 +93,8 @@ impl Default for ExplodeUi {
             joint_to: None,
             joint_axis: AxisChoice::ScreenVertical,
             joint_limits: None,
+            brush: Brush::default(),
+            last_dab: None,
         }
     }
 }
@@ -132,11 +143,27 @@ pub fn explode_input(
                 edits.queue.push(Edit::Pick { dataset, ray });
                 None
             }
+            Tool::Paint => {
+                edits.queue.push(Edit::Paint { dataset, ray, brush: brush(&ui, &keys), new_stroke: true });
+                ui.last_dab = Some(p);
+                None
+            }
             Tool::None => None,
         };
         if let Some(splitter) = splitter {
             edits.queue.push(Edit::Split { dataset, splitter });
         }
+    }
+    if ui.tool == Tool::Paint && buttons.pressed(MouseButton::Left) && !buttons.just_pressed(MouseButton::Left) {
+        // A dab every few pixels of the drag, in the same stroke.
+        pointer.press_taken = true;
+        if ui.last_dab.is_some_and(|last| last.distance(p) >= DAB_SPACING) {
+            edits.queue.push(Edit::Paint { dataset, ray, brush: brush(&ui, &keys), new_stroke: false });
+            ui.last_dab = Some(p);
+        }
+    }
+    if buttons.just_released(MouseButton::Left) {
+        ui.last_dab = None;
     }
     if ui.tool == Tool::Line && buttons.pressed(MouseButton::Left) && ui.line_start.is_some() {
         // The segment is the tool's, not the camera's.
@@ -148,6 +175,15 @@ pub fn explode_input(
     {
         edits.queue.push(Edit::Split { dataset, splitter: Splitter::Line { camera: cam, a, b: p, size: UVec2::new(w, h) } });
     }
+}
+
+/// Viewport pixels between two dabs of a drag.
+const DAB_SPACING: f32 = 4.0;
+
+/// The brush as set in the panel, erasing instead of adding while Shift is held.
+fn brush(ui: &ExplodeUi, keys: &ButtonInput<KeyCode>) -> Brush {
+    let shift = keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]);
+    Brush { erase: ui.brush.erase != shift, ..ui.brush }
 }
 
 /// Draws the segment being drawn with the line splitter.
@@ -178,15 +214,17 @@ pub fn explode_panel(
     joints: Query<(Entity, &PartJoint)>,
     cams: Query<(&OrbitCamera, &Camera), With<MainCamera>>,
     primary: Query<&Window, With<PrimaryWindow>>,
+    sources: Query<&ExplodeSource>,
     mut commands: Commands,
 ) -> Result {
     if !state.show_explode {
         return Ok(());
     }
     let ctx = contexts.ctx_mut()?.clone();
-    if let (Ok(window), Ok((_, camera))) = (primary.single(), cams.single()) {
-        let (origin, _) = viewport_logical(camera, window);
+    if let (Ok(window), Ok((orbit, camera))) = (primary.single(), cams.single()) {
+        let (origin, size) = viewport_logical(camera, window);
         line_overlay(&ctx, &ui_state, origin, window.cursor_position());
+        brush_overlay(&ctx, &ui_state, orbit, size, window.cursor_position());
     }
     let mut sorted: Vec<(Entity, &Dataset, Option<&SplitHistory>)> = datasets.iter().collect();
     sorted.sort_by_key(|d| d.0);
@@ -210,6 +248,9 @@ pub fn explode_panel(
                     ui.add(egui::Slider::new(&mut x.coefficients.delta_viewing, 0.0..=2.0).text("δ viewing"));
                     ui.add(egui::Slider::new(&mut x.coefficients.delta_spacing, 0.0..=2.0).text("δ spacing"));
                 });
+                if let Ok(source) = sources.get(dataset) {
+                    selection_section(ui, &mut ui_state, &mut edits, dataset, source);
+                }
                 ui.separator();
                 ui.label("Split (click a part; line: drag across parts; Esc: stop)");
                 ui.horizontal_wrapped(|ui| {

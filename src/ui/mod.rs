@@ -8,6 +8,7 @@
 pub mod clip_gizmo;
 pub mod clip_panel;
 pub mod explode_panel;
+pub mod explode_selection;
 pub mod lenses;
 pub mod loading;
 pub mod objects_panel;
