@@ -240,6 +240,45 @@ fn at_rest_the_exploded_dataset_looks_as_before_and_exploded_its_selection_stays
 }
 
 #[test]
+fn parts_at_rest_draw_as_one_region_and_the_selection_only_where_it_can_draw() {
+    use focal::dataset::SceneRegions;
+    let mut app = app();
+    let (dataset, parts) = exploded_head(&mut app, 4);
+    app.update();
+    let scene = app.world().resource::<SceneRegions>().scene.clone();
+    // At rest: the 64 parts as the one box, and the selection's region.
+    assert_eq!(scene.regions.len(), 2);
+    let volume = app.world().get::<Dataset>(dataset).unwrap().volume.clone();
+    let (lo, hi) = volume.grid.world_bounds();
+    let box_vertices = focal::region::vertices(&scene.regions[0].planes);
+    assert!(box_vertices.iter().all(|v| v.cmpge(lo - 1e-3).all() && v.cmple(hi + 1e-3).all()));
+    // The selection's region holds the 40 mm sphere and little more (its bricks of 8
+    // voxels, 30 mm at 3.75 mm a voxel, aprons included).
+    let sel = focal::region::vertices(&scene.regions[1].planes);
+    let centre = volume.grid.center();
+    assert!(sel.iter().all(|v| (*v - centre).abs().max_element() < 40.0 + 2.0 * 30.0), "{sel:?}");
+    assert!(sel.iter().any(|v| (*v - centre).abs().max_element() >= 40.0));
+    // The two overlap: the ray caster is told to composite both there (a sample inside
+    // both must not be the selection's alone).
+    let prepared = focal::reference::prepare(&scene).unwrap();
+    assert!(focal::render::pack::overlaps(&prepared).dvr_pairs);
+    // Exploded: a region per part; the parts that do not meet the selection's box
+    // draw without its weight, those that do with it.
+    set_degree(&mut app, dataset, 1.0);
+    step(app.world_mut(), 120);
+    app.update();
+    let scene = app.world().resource::<SceneRegions>().scene.clone();
+    assert_eq!(scene.regions.len(), parts.len() + 1);
+    let weighted = scene.regions[..parts.len()].iter().filter(|r| scene.appearances[r.appearance].selection.is_some()).count();
+    assert!(weighted > 0 && weighted < parts.len(), "{weighted} of {} parts weighted", parts.len());
+    // Back at rest, one box again.
+    set_degree(&mut app, dataset, 0.0);
+    step(app.world_mut(), 1200);
+    app.update();
+    assert_eq!(app.world().resource::<SceneRegions>().scene.regions.len(), 2);
+}
+
+#[test]
 fn scene_files_explode_datasets() {
     use focal::scene::file::SceneFile;
     use focal::scene::load::{apply, load_datasets};

@@ -78,9 +78,6 @@ fn world_step(r: Region, dir: vec3<f32>) -> f32 {
     return r.native_step / max(length((r.to_native * vec4(dir, 0.0)).xyz), 1e-9);
 }
 
-// a, or b when `second` (field by field: a loop that alternates between two regions
-// keeps both records in registers instead of loading one per sample). Lists every
-// field of Region (types.wgsl): keep them in step.
 fn pick_region(a: Region, b: Region, second: bool) -> Region {
     var r: Region;
     for (var c = 0; c < 4; c++) {

@@ -1,14 +1,23 @@
 //! Parts as regions (DESIGN.md, "One rendering idea"): each part is its rest polyhedron
 //! moved by its rigid body, sampling the volume through the inverse of that motion, so
 //! the data inside a part travels with it. Pure; the ECS system calls it.
+//!
+//! What the ray caster is given is also kept as small as the picture allows (each
+//! region a ray crosses costs it a segment, each overlap a sample of both):
+//! - parts that all move alike (at rest, before the explosion) draw as one region, the
+//!   dataset's box under that motion ([`moving_as_one`]);
+//! - the selection's region is the dataset's box cut to the box of the selection's
+//!   non-zero bricks ([`selection_box`]): outside it every degree of interest is 0; and
+//!   to the bricks its look can draw in ([`drawn_part`]);
+//! - only parts that meet that box need the selection's weight (elsewhere `1 − doi` is 1).
 
-use glam::Affine3A;
+use glam::{Affine3A, Vec3};
 
 use super::parts::Polyhedron;
 use super::splitters::in_part_frame;
 use crate::clip::Clipping;
-use crate::region::Region;
-use crate::volume::Grid;
+use crate::region::{Appearance, Plane, Region, bounding_planes, box_planes, has_volume};
+use crate::volume::{Grid, Volume};
 
 /// A part placed for rendering: its rest polyhedron (dataset frame) and its motion
 /// (dataset frame → dataset frame).
@@ -31,6 +40,56 @@ pub fn part_regions(grid: &Grid, dataset_to_world: Affine3A, clip: &Clipping, in
             Region { planes, holes: Vec::new(), world_to_voxel: grid.world_to_index() * from_world, volume: index, appearance: index }
         })
         .collect()
+}
+
+/// The box of `selection`'s non-zero bricks (their one-voxel aprons included, so every
+/// trilinear sample outside it is 0) as planes in the dataset's frame; `None` when
+/// nothing is selected.
+pub fn selection_box(selection: &Volume) -> Option<Vec<Plane>> {
+    let bricks = selection.bricks();
+    let selected: Vec<bool> = bricks.max.iter().map(|m| *m > 0).collect();
+    let (lo, hi) = bricks.bounds_where(&selected)?;
+    let dims = selection.dims().as_vec3();
+    Some(box_planes(&selection.grid.world_to_index(), lo.max(Vec3::splat(-0.5)), hi.min(dims - 0.5)))
+}
+
+/// The selection's region: `dataset` (a dataset's region) cut to `selection_box` (dataset
+/// frame) placed by `dataset_to_world`.
+pub fn selection_region(dataset: Region, selection_box: &[Plane], dataset_to_world: Affine3A) -> Region {
+    let to_dataset = dataset_to_world.inverse();
+    let mut planes = dataset.planes.clone();
+    planes.extend(selection_box.iter().map(|pl| in_part_frame(*pl, to_dataset)));
+    Region { planes: bounding_planes(&planes), ..dataset }
+}
+
+/// `region` (showing `volume`) cut to the box of the bricks `look` can draw in (its
+/// occupancy; for the selection's look, where the data is visible and selected);
+/// `None` when it draws nowhere.
+pub fn drawn_part(region: Region, look: &Appearance, volume: &Volume) -> Option<Region> {
+    let Some(occupied) = look.brick_occupancy(volume) else { return Some(region) };
+    let (lo, hi) = volume.bricks().bounds_where(&occupied)?;
+    let dims = volume.dims().as_vec3();
+    Some(region.cut_to_index_box(lo.max(Vec3::splat(-0.5)), hi.min(dims - 0.5)))
+}
+
+/// Whether a part (rest polyhedron, dataset frame) meets the selection's box.
+pub fn meets(rest: &Polyhedron, selection_box: &[Plane]) -> bool {
+    let mut planes = rest.planes.clone();
+    planes.extend_from_slice(selection_box);
+    has_volume(&planes)
+}
+
+/// The motion every part has when all `motions` are the same (to 10⁻⁴ mm over the
+/// dataset's `extent` and in rotation), so the parts together are the dataset's box
+/// moved by it: they draw as one region. `None` when they differ or there are none.
+pub fn moving_as_one(motions: &[Affine3A], extent: f32) -> Option<Affine3A> {
+    let first = *motions.first()?;
+    let tolerance = 1e-4 * extent.max(1.0);
+    let alike = |m: &Affine3A| {
+        let probe = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z].map(|v| v * extent);
+        probe.iter().all(|p| m.transform_point3(*p).distance(first.transform_point3(*p)) <= tolerance)
+    };
+    motions.iter().all(alike).then_some(first)
 }
 
 #[cfg(test)]
@@ -57,5 +116,51 @@ mod tests {
         // Voxel (7, 5, 5) belongs to the other half: not in this region, wherever it is.
         assert!(!r.contains((dataset * motion).transform_point3(Vec3::new(7.0, 5.0, 5.0))));
         assert!(!r.contains(dataset.transform_point3(Vec3::new(2.0, 5.0, 5.0))), "the part left its place");
+    }
+
+    #[test]
+    fn the_selection_box_its_region_and_the_parts_it_meets() {
+        use crate::volume::SelectionVolume;
+        // 32³ voxels of 2 mm; voxels 10..=13 along x, 4..=5 along y and z selected. The
+        // bricks (8 voxels) holding them, aprons included: x 8..16 → index box
+        // [7.5, 15.5], y and z brick 0 → [−0.5, 7.5].
+        let g = Grid::new(glam::UVec3::splat(32), Vec3::splat(2.0));
+        let mut codes = vec![0u8; 32 * 32 * 32];
+        for x in 10..=13 {
+            for yz in 4..=5 {
+                codes[(yz * 32 + yz) * 32 + x] = 255;
+            }
+        }
+        let sel = SelectionVolume::from_codes(g.clone(), codes).unwrap().volume;
+        let planes = selection_box(&sel).unwrap();
+        let to_world = g.index_to_world();
+        let inside = |p: Vec3| planes.iter().all(|pl| pl.distance(to_world.transform_point3(p)) <= 1e-4);
+        assert!(inside(Vec3::new(7.6, -0.4, 7.4)) && inside(Vec3::new(15.4, 7.4, 0.0)));
+        assert!(!inside(Vec3::new(7.4, 3.0, 3.0)) && !inside(Vec3::new(15.6, 3.0, 3.0)) && !inside(Vec3::new(10.0, 7.6, 3.0)));
+        assert!(selection_box(&SelectionVolume::empty(g.clone()).volume).is_none());
+        // Its region in a dataset moved 100 mm along z: the box moved too.
+        let dataset = Affine3A::from_translation(Vec3::new(0.0, 0.0, 100.0));
+        let whole = Region::dataset(&g, dataset, &Clipping::default(), 0);
+        let r = selection_region(whole, &planes, dataset);
+        let at = |q: Vec3| dataset.transform_point3(to_world.transform_point3(q));
+        assert!(r.contains(at(Vec3::new(11.0, 4.0, 4.0))) && !r.contains(at(Vec3::new(20.0, 4.0, 4.0))));
+        // The parts left of x = 7 mm (index 3.5) miss it; those across it meet it.
+        let left = Polyhedron::cuboid(to_world.transform_point3(Vec3::splat(-0.5)), to_world.transform_point3(Vec3::new(3.5, 31.5, 31.5)));
+        let across =
+            Polyhedron::cuboid(to_world.transform_point3(Vec3::splat(-0.5)), to_world.transform_point3(Vec3::new(9.5, 31.5, 31.5)));
+        assert!(!meets(&left, &planes) && meets(&across, &planes));
+    }
+
+    #[test]
+    fn parts_moving_alike_draw_as_one() {
+        let shift = Affine3A::from_translation(Vec3::new(0.0, 5.0, 0.0));
+        assert_eq!(moving_as_one(&[Affine3A::IDENTITY; 3], 200.0), Some(Affine3A::IDENTITY));
+        assert_eq!(moving_as_one(&[shift, shift], 200.0), Some(shift));
+        assert_eq!(moving_as_one(&[Affine3A::IDENTITY, shift], 200.0), None);
+        // A turn of 10⁻⁵ rad moves the box's far corner 2 µm: alike; 10⁻³ rad: not.
+        let turn = |a: f32| Affine3A::from_rotation_z(a);
+        assert!(moving_as_one(&[Affine3A::IDENTITY, turn(1e-5)], 200.0).is_some());
+        assert!(moving_as_one(&[Affine3A::IDENTITY, turn(1e-3)], 200.0).is_none());
+        assert_eq!(moving_as_one(&[], 200.0), None);
     }
 }

@@ -404,15 +404,16 @@ impl std::fmt::Debug for LoadedExplode {
 }
 
 /// Gives dataset entity `dataset` its exploded view and parts (replacing any it had),
-/// at rest.
-pub fn replace_explosion(world: &mut World, dataset: Entity, loaded: Option<&LoadedExplode>) {
+/// at rest. Returns the parts' entities in the order of `loaded.parts` (entity order
+/// need not follow it: despawned entities are reused).
+pub fn replace_explosion(world: &mut World, dataset: Entity, loaded: Option<&LoadedExplode>) -> Vec<Entity> {
     let old: Vec<Entity> = world.query::<(Entity, &Part)>().iter(world).filter(|(_, p)| p.dataset == dataset).map(|(e, _)| e).collect();
     for e in old {
         world.despawn(e);
     }
     let Some(loaded) = loaded else {
         world.entity_mut(dataset).remove::<(Exploded, super::components::ExplosionPoints, super::components::ExplodeSource)>();
-        return;
+        return Vec::new();
     };
     world.entity_mut(dataset).insert((loaded.exploded.clone(), super::components::ExplodeSource(loaded.spec.clone())));
     let spec = &loaded.spec;
@@ -435,6 +436,7 @@ pub fn replace_explosion(world: &mut World, dataset: Entity, loaded: Option<&Loa
     for j in &spec.joints {
         world.spawn(j.joint(|i| entities.get(i).copied().unwrap_or(Entity::PLACEHOLDER)));
     }
+    entities
 }
 
 #[cfg(test)]

@@ -19,7 +19,7 @@ use super::forces::{PartNow, Scale, Surroundings, Wrench, part_wrench};
 use super::joints::{build_joints, group_joints};
 use super::parts::Polyhedron;
 use super::points::explosion_points;
-use super::regions::{PlacedPart, part_regions};
+use super::regions::{PlacedPart, drawn_part, meets, moving_as_one, part_regions, selection_box, selection_region};
 use crate::dataset::{Dataset, GpuVolume, RegionSystems, SceneRegions};
 use crate::region::{Appearance, Keep, Region, SelectionWeight, box_planes};
 use crate::transfer::Lut;
@@ -284,8 +284,9 @@ pub fn apply_forces(
 }
 
 /// Replaces each exploded dataset's region by its parts' regions (drawing the data less
-/// the selection) and the selection's own region (its box, not moved, drawing the data
-/// in the selection), the parts first.
+/// the selection) and the selection's own region (the box of its non-zero bricks, not
+/// moved, drawing the data in the selection), the parts first; parts that all move
+/// alike draw as one region ([`super::regions`]).
 pub fn exploded_regions(
     parts: Query<(&Part, &Transform, Option<&PartFade>)>,
     datasets: Query<(Entity, &Dataset, &Exploded, Option<&GpuVolume>, &GlobalTransform)>,
@@ -312,34 +313,50 @@ pub fn exploded_regions(
         if parts.iter().all(|(p, ..)| p.dataset != entity) {
             continue;
         }
-        let visible: Vec<_> = parts.iter().filter(|(p, ..)| p.dataset == entity && !p.hidden).collect();
-        let placed: Vec<PlacedPart> = visible.iter().map(|(p, t, _)| PlacedPart { rest: &p.rest, motion: t.compute_affine() }).collect();
+        let all: Vec<_> = parts.iter().filter(|(p, ..)| p.dataset == entity).collect();
+        let visible: Vec<_> = all.iter().filter(|(p, ..)| !p.hidden).collect();
         let fades: Vec<f32> = visible.iter().map(|(.., f)| f.map_or(1.0, |f| f.0)).collect();
         let grid = &shown(d, gpu).grid;
+        let selection_box = x.selection.as_deref().and_then(selection_box);
+        let motions: Vec<Affine3A> = visible.iter().map(|(_, t, _)| t.compute_affine()).collect();
+        // All parts shown, moving alike and looking alike: one region, the box.
+        let whole = volume_polyhedron(&d.volume);
+        let one = moving_as_one(&motions, grid.extent().length())
+            .filter(|_| visible.len() == all.len() && fades.iter().all(|f| *f == fades[0]))
+            .zip(whole.as_ref());
+        let (placed, fades): (Vec<PlacedPart>, Vec<f32>) = match one {
+            Some((motion, rest)) => (vec![PlacedPart { rest, motion }], vec![fades[0]]),
+            None => (visible.iter().zip(&motions).map(|((p, ..), m)| PlacedPart { rest: &p.rest, motion: *m }).collect(), fades),
+        };
         let mut regions = part_regions(grid, global.affine(), &d.clip, volume_index, &placed);
         let own = scene.appearances.get(volume_index).cloned().unwrap_or_else(|| d.appearance.clone());
         let weighted = |look: &Appearance, keep: Keep| match &x.selection {
             Some(selection) => Appearance { selection: Some(SelectionWeight { volume: selection.clone(), keep }), ..look.clone() },
             None => look.clone(),
         };
-        // The parts' look: the data less the selection, faded per part (one look per
-        // opacity step).
-        let mut looks: Vec<(u32, usize)> = Vec::new();
-        for (r, o) in regions.iter_mut().zip(&fades) {
-            let key = (o * 1000.0).round() as u32;
+        // The parts' look: the data less the selection where they meet its box, faded per
+        // part (one look per opacity step).
+        let mut looks: Vec<((u32, bool), usize)> = Vec::new();
+        for ((r, o), p) in regions.iter_mut().zip(&fades).zip(&placed) {
+            let near = selection_box.as_ref().is_some_and(|b| meets(p.rest, b));
+            let key = ((o * 1000.0).round() as u32, near);
             r.appearance = match looks.iter().find(|l| l.0 == key) {
                 Some(l) => l.1,
                 None => {
-                    scene.appearances.push(weighted(&own, Keep::Unselected).with_opacity_scaled(*o));
+                    let look = if near { weighted(&own, Keep::Unselected) } else { own.clone() };
+                    scene.appearances.push(look.with_opacity_scaled(*o));
                     looks.push((key, scene.appearances.len() - 1));
                     scene.appearances.len() - 1
                 }
             };
         }
-        if x.selection.is_some() {
-            scene.appearances.push(weighted(x.selection_look.as_ref().unwrap_or(&own), Keep::Selected));
-            regions
-                .push(Region { appearance: scene.appearances.len() - 1, ..Region::dataset(grid, global.affine(), &d.clip, volume_index) });
+        if let Some(b) = &selection_box {
+            let look = weighted(x.selection_look.as_ref().unwrap_or(&own), Keep::Selected);
+            let dataset = Region { appearance: scene.appearances.len(), ..Region::dataset(grid, global.affine(), &d.clip, volume_index) };
+            if let Some(region) = drawn_part(selection_region(dataset, b, global.affine()), &look, &shown(d, gpu)) {
+                scene.appearances.push(look);
+                regions.push(region);
+            }
         }
         scene.regions.splice(region_index..=region_index, regions);
         changed = true;

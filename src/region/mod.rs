@@ -100,15 +100,14 @@ pub fn has_volume(planes: &[Plane]) -> bool {
     }
     let (lo, hi) = v.iter().fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), p| (a.min(*p), b.max(*p)));
     let scale = (hi - lo).max_element().max(1e-6);
-    // Some vertex lies off the plane of three others by a noticeable fraction.
-    let (a, b, c) = (v[0], v[1], v[2]);
-    let mut normal = (b - a).cross(c - a);
-    if normal.length() < 1e-9 * scale * scale {
-        // The first three are collinear: find a non-collinear third.
-        normal = v.iter().map(|p| (b - a).cross(*p - a)).max_by(|x, y| x.length().total_cmp(&y.length())).unwrap_or(Vec3::ZERO);
-    }
+    // Some vertex lies off the plane of three others by a noticeable fraction: a, the
+    // vertex farthest from it, and the one farthest off their line (vertices repeat
+    // where more than three planes meet, or planes do).
+    let a = v[0];
+    let Some(b) = v.iter().copied().max_by(|x, y| x.distance_squared(a).total_cmp(&y.distance_squared(a))) else { return false };
+    let normal = v.iter().map(|p| (b - a).cross(*p - a)).max_by(|x, y| x.length().total_cmp(&y.length())).unwrap_or(Vec3::ZERO);
     let len = normal.length();
-    len > 0.0 && v.iter().any(|p| ((*p - a).dot(normal) / len).abs() > 1e-4 * scale)
+    len > 1e-9 * scale * scale && v.iter().any(|p| ((*p - a).dot(normal) / len).abs() > 1e-4 * scale)
 }
 
 /// Length of the longest diagonal of a box of `dims` voxels under the linear map
@@ -256,6 +255,26 @@ pub fn box_planes(world_to_index: &Affine3A, lo: Vec3, hi: Vec3) -> Vec<Plane> {
 mod tests {
     use super::*;
     use glam::{Mat3, UVec3};
+
+    #[test]
+    fn volume_and_bounding_planes_with_repeated_planes() {
+        let unit = box_planes(&Affine3A::IDENTITY, Vec3::ZERO, Vec3::ONE);
+        assert!(has_volume(&unit));
+        // The same box given twice (a region cut to a box it already had): its vertices
+        // repeat, it still has volume, and each face keeps one plane.
+        let twice: Vec<Plane> = unit.iter().chain(&unit).copied().collect();
+        assert!(has_volume(&twice));
+        assert_eq!(bounding_planes(&twice).len(), 6);
+        // Cut to a slab of no thickness: no volume.
+        let mut flat = twice.clone();
+        flat.push(Plane { normal: Vec3::X, offset: 0.0 });
+        assert!(!has_volume(&flat));
+        // Cut by a plane through it: volume, seven planes of which the far x face goes.
+        let mut cut = unit.clone();
+        cut.push(Plane { normal: Vec3::X, offset: 0.5 });
+        assert!(has_volume(&cut));
+        assert_eq!(bounding_planes(&cut).len(), 6);
+    }
 
     #[test]
     fn ray_box_entry_and_exit() {

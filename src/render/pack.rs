@@ -267,16 +267,20 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
 }
 
 /// Appends the selection record of a weighted region (the selection volume in atlas
-/// slot `slot`, mapped from the data's voxel index) and returns its index; one record
-/// per selection volume and data grid is shared by all the regions that use it.
+/// slot `slot`, mapped from the data's voxel index, with its brick min-max grid) and
+/// returns its index; one record per selection volume and data grid is shared by all
+/// the regions that use it.
 fn pack_selection(p: &PreparedRegion, slot: usize, out: &mut PackedScene) -> u32 {
     let Some(w) = &p.weight else { return 0 };
     let volume = &w.weight.volume;
     let map = Mat4::from(w.data_to_selection);
     let (a, b) = ((volume.values.slope * volume.code_max() as f64) as f32, volume.values.intercept as f32);
+    let bricks = volume.bricks();
     let record = GpuRegion {
         world_to_voxel: map,
         dims: volume.dims().as_vec3().extend(volume.code_max() as f32),
+        bricks: bricks.dims.extend(bricks.size),
+        occupancy_offset: out.occupancy.len() as u32,
         atlas_offset: out.levels[slot][0].as_vec3().extend(0.0),
         mode: mode::OFF,
         lut_a: a,
@@ -284,11 +288,34 @@ fn pack_selection(p: &PreparedRegion, slot: usize, out: &mut PackedScene) -> u32
         ..Default::default()
     };
     let first = out.region_count as usize;
-    if let Some(i) = out.regions[first..].iter().position(|r| *r == record) {
+    // (Equal but for where their brick kinds are: the same selection.)
+    let key = |r: &GpuRegion| {
+        let mut k = *r;
+        k.occupancy_offset = 0;
+        k
+    };
+    if let Some(i) = out.regions[first..].iter().position(|r| key(r) == key(&record)) {
         return (first + i) as u32;
     }
+    out.occupancy.extend(constant_bricks(bricks, volume.voxels.code_max() as u16));
     out.regions.push(record);
     out.regions.len() as u32 - 1
+}
+
+/// Two bits per brick (16 a word, bricks in order): 0 when every code a sample in it
+/// can read is 0, 1 when every one is `full`, 2 otherwise. The shader samples a
+/// selection only in bricks of kind 2.
+pub fn constant_bricks(bricks: &crate::volume::BrickGrid, full: u16) -> Vec<u32> {
+    let mut words = vec![0u32; bricks.min.len().div_ceil(16)];
+    for (i, (&lo, &hi)) in bricks.min.iter().zip(&bricks.max).enumerate() {
+        let kind = match (lo, hi) {
+            (0, 0) => 0,
+            (a, b) if a == full && b == full => 1,
+            _ => 2,
+        };
+        words[i / 16] |= kind << (2 * (i % 16));
+    }
+    words
 }
 
 /// Most iterations any loop of the ray caster can make on one ray through `regions`:
@@ -553,6 +580,21 @@ mod tests {
             native_step,
             ..Default::default()
         }
+    }
+
+    #[test]
+    fn selection_bricks_by_kind() {
+        use crate::volume::BrickGrid;
+        // Bricks: none selected, all, a mix, one middle code, and a 17th (second word).
+        let mut bricks = BrickGrid { size: 8, dims: glam::UVec3::new(17, 1, 1), min: vec![0; 17], max: vec![0; 17] };
+        (bricks.min[1], bricks.max[1]) = (255, 255);
+        (bricks.min[2], bricks.max[2]) = (0, 255);
+        (bricks.min[3], bricks.max[3]) = (10, 10);
+        (bricks.min[16], bricks.max[16]) = (0, 3);
+        let words = constant_bricks(&bricks, 255);
+        assert_eq!(words.len(), 2);
+        let kind = |i: usize| (words[i / 16] >> (2 * (i % 16))) & 3;
+        assert_eq!((kind(0), kind(1), kind(2), kind(3), kind(4), kind(16)), (0, 1, 2, 2, 0, 2));
     }
 
     #[test]

@@ -76,6 +76,9 @@ pub struct BenchArgs {
     /// Only the exploded views group (the paper's table 1).
     #[arg(long)]
     explode: bool,
+    /// With --explode: only these part counts (1, 2, 4, 8, 16, 32, 64; comma-separated).
+    #[arg(long, value_delimiter = ',', value_name = "N,...")]
+    parts: Vec<usize>,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -378,7 +381,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
     }
 
     if all || args.explode {
-        explode::group(&mut bench, &mut rows, args.resolution)?;
+        explode::group(&mut bench, &mut rows, args.resolution, &args.parts)?;
     }
 
     if all || args.lenses {
