@@ -37,7 +37,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 13] = [
+const DEFS: [&str; 14] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -51,6 +51,7 @@ const DEFS: [&str; 13] = [
     "DVR_PAIRS",
     "LENS_ANTIALIAS",
     "HAS_SELECTION",
+    "HAS_HOLES",
 ];
 
 #[test]
@@ -59,8 +60,13 @@ fn every_shader_variant_composes_and_validates() {
     // Every combination the renderer can ask for: anti-aliasing only with lenses, DVR
     // pairs and selection weights only with DVR.
     let needs = |a: &str, b: &str, bits: u32| bits & bit(a) == 0 || bits & bit(b) != 0;
+    // Holes touch the interval code only: with the defs that share it, not every other.
+    let interval_defs = bit("HAS_HOLES") | bit("HAS_DVR") | bit("MULTI_REGION") | bit("DVR_PAIRS") | bit("HAS_TWO_LEVEL");
     let possible = |bits: u32| {
-        needs("LENS_ANTIALIAS", "HAS_LENSES", bits) && needs("DVR_PAIRS", "HAS_DVR", bits) && needs("HAS_SELECTION", "HAS_DVR", bits)
+        needs("LENS_ANTIALIAS", "HAS_LENSES", bits)
+            && needs("DVR_PAIRS", "HAS_DVR", bits)
+            && needs("HAS_SELECTION", "HAS_DVR", bits)
+            && (bits & bit("HAS_HOLES") == 0 || bits & !interval_defs == 0)
     };
     for bits in (0u32..(1 << DEFS.len())).filter(|b| possible(*b)) {
         let defs: HashMap<String, ShaderDefValue> = DEFS

@@ -65,9 +65,12 @@ pub mod features {
     pub const LENS_ANTIALIAS: u32 = 2048;
     /// Some region's opacity is weighted by a selection (exploded views).
     pub const SELECTION: u32 = 4096;
+    /// Some region has holes (clip windows): the intervals are cut (llvmpipe ran that
+    /// code for every region of every ray, holes or not).
+    pub const HOLES: u32 = 8192;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 13] = [
+    pub const NAMES: [(u32, &str); 14] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -81,6 +84,7 @@ pub mod features {
         (DVR_PAIRS, "DVR_PAIRS"),
         (LENS_ANTIALIAS, "LENS_ANTIALIAS"),
         (SELECTION, "HAS_SELECTION"),
+        (HOLES, "HAS_HOLES"),
     ];
 }
 

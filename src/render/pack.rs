@@ -450,6 +450,9 @@ pub fn scene_features(regions: &[GpuRegion], overlaps: Overlaps) -> u32 {
         if r.flags & region_flags::SHADING != 0 {
             bits |= f::SHADING;
         }
+        if r.hole_count > 0 {
+            bits |= f::HOLES;
+        }
         // (Weights act on DVR samples only: with DVR in the shader.)
         if r.flags & region_flags::SELECTION != 0 && bits & f::DVR != 0 {
             bits |= f::SELECTION;
@@ -665,7 +668,7 @@ mod tests {
         ];
         let packed = pack(&scene, 2048).unwrap();
         assert_eq!(packed.region_count, 2);
-        assert_eq!(packed.features & (features::MULTI_REGION | features::DVR_PAIRS), 0);
+        assert_eq!(packed.features & (features::MULTI_REGION | features::DVR_PAIRS | features::HOLES), 0);
         // The whole volume and one half overlap: two DVR regions, the pair loop.
         scene.regions[0] = whole.clone();
         assert_eq!(pack(&scene, 2048).unwrap().features & (features::MULTI_REGION | features::DVR_PAIRS), features::DVR_PAIRS);
@@ -684,6 +687,7 @@ mod tests {
         let packed = pack(&scene, 2048).unwrap();
         assert_eq!(packed.features & (features::MULTI_REGION | features::DVR_PAIRS), 0);
         assert_eq!((packed.regions[0].hole_count, packed.regions[0].hole_offset), (1, 6));
+        assert_ne!(packed.features & features::HOLES, 0, "the hole code is compiled in");
         // A hole that holds only part of the common part leaves an overlap.
         let small = crate::region::box_planes(&glam::Affine3A::IDENTITY, centre, hi + 1.0);
         scene.regions[0].holes[0] = std::array::from_fn(|i| small[i]);
