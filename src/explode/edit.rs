@@ -256,7 +256,13 @@ fn dataset_to_world(world: &World, dataset: Entity) -> Affine3A {
 /// The first visible background point on `ray` (world), picked by the CPU reference in
 /// the scene without the selection's regions.
 fn first_background_hit(world: &World, ray: Ray) -> Result<Option<Vec3>, String> {
-    let mut scene = world.resource::<SceneRegions>().scene.clone();
+    background_hit(&world.resource::<SceneRegions>().scene, ray)
+}
+
+/// The first visible point of `scene` on `ray` that is not the selection's (what the
+/// splitters cut at).
+pub fn background_hit(scene: &crate::region::RenderScene, ray: Ray) -> Result<Option<Vec3>, String> {
+    let mut scene = scene.clone();
     let appearances = scene.appearances.clone();
     scene.regions.retain(|r| appearances.get(r.appearance).is_none_or(|a| a.selection.as_ref().is_none_or(|s| s.keep != Keep::Selected)));
     Ok(crate::reference::pick(&scene, ray)?.map(|h| h.position))
@@ -265,11 +271,17 @@ fn first_background_hit(world: &World, ray: Ray) -> Result<Option<Vec3>, String>
 /// The part of `dataset` at world point `p` (the nearest, for a point on a face).
 fn part_at(world: &mut World, dataset: Entity, p: Vec3) -> Option<Entity> {
     let to_world = dataset_to_world(world, dataset);
-    parts_of(world, dataset)
-        .into_iter()
+    let parts = parts_of(world, dataset);
+    nearest_part(parts.iter().map(|(e, part, t)| (*e, part, to_world * t.compute_affine())), p)
+}
+
+/// Of `parts` (entity, part, rest frame → world), the shown one nearest to world point
+/// `p`.
+pub fn nearest_part<'a>(parts: impl Iterator<Item = (Entity, &'a Part, Affine3A)>, p: Vec3) -> Option<Entity> {
+    parts
         .filter(|(_, part, _)| !part.hidden)
-        .map(|(e, part, t)| {
-            let rest = (to_world * t.compute_affine()).inverse().transform_point3(p);
+        .map(|(e, part, to_world)| {
+            let rest = to_world.inverse().transform_point3(p);
             (e, part.rest.closest_point(rest).distance(rest))
         })
         .min_by(|a, b| a.1.total_cmp(&b.1))

@@ -125,6 +125,13 @@ impl Polyhedron {
         self.radius
     }
 
+    /// Where `plane` cuts the polyhedron: the cut face's vertices in order around it
+    /// (empty when the plane misses it or only touches it).
+    pub fn section(&self, plane: Plane) -> Vec<Vec3> {
+        let Some((half, _)) = self.split(plane) else { return Vec::new() };
+        faces(&[plane], &half.vertices).into_iter().next().map_or_else(Vec::new, |(_, face)| face)
+    }
+
     /// The mean of the vertices.
     pub fn vertex_mean(&self) -> Vec3 {
         self.vertices.iter().copied().sum::<Vec3>() / self.vertices.len().max(1) as f32
@@ -265,6 +272,24 @@ mod tests {
             let nearest = inside.iter().map(|x| x.distance(p)).fold(f32::INFINITY, f32::min);
             assert!(q.distance(p) <= nearest + 1e-4, "{p}: {q} at {} but a point at {nearest}", q.distance(p));
         }
+    }
+
+    #[test]
+    fn sections_are_the_cut_faces() {
+        // The unit cube cut at x = ¼: the square x = ¼, 0 ≤ y, z ≤ 1, in order around.
+        let cube = Polyhedron::cuboid(Vec3::ZERO, Vec3::ONE);
+        let s = cube.section(Plane::through(Vec3::new(0.25, 0.0, 0.0), Vec3::X));
+        assert_eq!(s.len(), 4);
+        assert!(s.iter().all(|v| (v.x - 0.25).abs() < 1e-5));
+        for (a, b) in s.iter().zip(s.iter().cycle().skip(1)) {
+            assert!((a.distance(*b) - 1.0).abs() < 1e-5, "neighbours share an edge: {a} {b}");
+        }
+        // Across a corner: a triangle; x + y + z = 2.5 cuts off the corner (1, 1, 1).
+        let t = cube.section(Plane::through(Vec3::new(1.0, 1.0, 0.5), Vec3::ONE));
+        assert_eq!(t.len(), 3);
+        // Missing or touching: nothing.
+        assert!(cube.section(Plane::through(Vec3::splat(2.0), Vec3::X)).is_empty());
+        assert!(cube.section(Plane::through(Vec3::ONE, Vec3::X)).is_empty());
     }
 
     #[test]

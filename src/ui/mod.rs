@@ -7,6 +7,7 @@
 
 pub mod clip_gizmo;
 pub mod clip_panel;
+pub mod explode_overlay;
 pub mod explode_panel;
 pub mod explode_selection;
 pub mod lenses;
@@ -138,6 +139,7 @@ impl Plugin for FocalAppPlugin {
             .init_resource::<clip_gizmo::ClipGizmo>()
             .init_resource::<window_tools::WindowTools>()
             .init_resource::<explode_panel::ExplodeUi>()
+            .init_resource::<explode_overlay::CutPreview>()
             .add_systems(
                 Startup,
                 move |mut commands: Commands, mut egui: ResMut<EguiGlobalSettings>, mut load: MessageWriter<LoadRequest>| {
@@ -170,7 +172,7 @@ impl Plugin for FocalAppPlugin {
             )
             // The exploded views' physics: as many steps as the frame's time asks for.
             .add_systems(Update, (crate::explode::systems::run_steps, open_explode_panel).after(orbit::apply_orbit))
-            .add_systems(EguiPrimaryContextPass, (panels::ui, explode_panel::explode_panel).chain());
+            .add_systems(EguiPrimaryContextPass, (panels::ui, explode_panel::explode_panel, explode_overlay::explode_overlay).chain());
     }
 }
 
