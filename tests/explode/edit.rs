@@ -23,11 +23,17 @@ fn parts(app: &mut App) -> Vec<(Entity, Part)> {
 
 /// The head CT (64³) exploded around its bone in one part; the camera in front.
 fn head() -> (App, Entity, Camera) {
+    head_exploded_as("(selection: Range(lo: 300.0, hi: 4000.0))")
+}
+
+/// The head CT (64³, skin and bone) exploded as the spec `spec` (RON) says, by the
+/// edit the app makes; the camera in front, 600 mm out on +y.
+pub fn head_exploded_as(spec: &str) -> (App, Entity, Camera) {
     let mut app = app();
     let v = Arc::new(Phantom::Head.generate(64).unwrap());
     let a = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap());
     let dataset = app.world_mut().spawn((Dataset::new(v, a), Transform::default())).id();
-    let spec: ExplodeSpec = ron::from_str("(selection: Range(lo: 300.0, hi: 4000.0))").unwrap();
+    let spec: ExplodeSpec = ron::from_str(spec).unwrap();
     apply(app.world_mut(), Edit::Explode { dataset, spec: Box::new(spec) }).unwrap();
     app.update();
     let camera = Camera::look_at(Vec3::new(0.0, 600.0, 0.0), Vec3::ZERO, Vec3::Z, Projection::Perspective { fov_y: 0.6 });

@@ -13,25 +13,15 @@ use focal::explode::spec::ExplodeSpec;
 use focal::explode::splitters::ScreenAxis;
 use focal::explode::{Exploded, ExplosionPoints, Part};
 
-use focal::region::{Appearance, Camera, Mode, Projection};
-use focal::transfer::presets;
+use focal::region::Camera;
 use focal::volume::Volume;
-use focal::volume::phantom::Phantom;
 
-use super::app;
+use super::edit::head_exploded_as;
 
 /// The head CT (64³) exploded around nothing (to paint from scratch); the camera in
 /// front.
 fn blank_head() -> (App, Entity, Camera) {
-    let mut app = app();
-    let v = Arc::new(Phantom::Head.generate(64).unwrap());
-    let a = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap());
-    let dataset = app.world_mut().spawn((Dataset::new(v, a), Transform::default())).id();
-    let spec: ExplodeSpec = ron::from_str("(selection: Nothing)").unwrap();
-    apply(app.world_mut(), Edit::Explode { dataset, spec: Box::new(spec) }).unwrap();
-    app.update();
-    let camera = Camera::look_at(Vec3::new(0.0, 600.0, 0.0), Vec3::ZERO, Vec3::Z, Projection::Perspective { fov_y: 0.6 });
-    (app, dataset, camera)
+    head_exploded_as("(selection: Nothing)")
 }
 
 fn selection(app: &App, dataset: Entity) -> Arc<Volume> {
@@ -149,12 +139,7 @@ fn strokes_are_saved_smoothing_replays_them_and_moved_parts_paint_their_data() {
 
 #[test]
 fn smoothing_softens_a_binary_selection() {
-    let mut app = app();
-    let v = Arc::new(Phantom::Head.generate(64).unwrap());
-    let a = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap());
-    let dataset = app.world_mut().spawn((Dataset::new(v, a), Transform::default())).id();
-    let spec: ExplodeSpec = ron::from_str("(selection: Range(lo: 300.0, hi: 4000.0))").unwrap();
-    apply(app.world_mut(), Edit::Explode { dataset, spec: Box::new(spec) }).unwrap();
+    let (mut app, dataset, _) = head_exploded_as("(selection: Range(lo: 300.0, hi: 4000.0))");
     let binary = selection(&app, dataset);
     let soft = |v: &Volume| (0..v.voxels.len()).filter(|&i| (1..255).contains(&v.voxels.code(i))).count();
     assert_eq!(soft(&binary), 0);
