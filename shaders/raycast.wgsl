@@ -29,7 +29,7 @@
 // loops that some lane never leaves; the comments below say where that shaped the code.
 
 #import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput
-#import focal::types::{Region, MODE_TWO_LEVEL, MODE_OFF, MODE_MIP, MODE_MIN_IP, MODE_X_RAY, MODE_GRADIENT_DVR, MODE_ISO, MODE_CONTEXT, REGION_LABELS, REGION_SHADING, REGION_OCCUPANCY, REGION_LAMBDA, VIEW_JITTER, VIEW_SKIP_EMPTY, VIEW_EARLY_TERMINATION, VIEW_DEBUG_RAYS, EARLY_TERMINATION, ISO_REFINEMENT, MAX_RAY_REGIONS}
+#import focal::types::{Region, MODE_TWO_LEVEL, MODE_OFF, MODE_MIP, MODE_MIN_IP, MODE_X_RAY, MODE_GRADIENT_DVR, MODE_ISO, MODE_CONTEXT, REGION_LABELS, REGION_SHADING, REGION_OCCUPANCY, REGION_LAMBDA, VIEW_JITTER, VIEW_SKIP_EMPTY, VIEW_EARLY_TERMINATION, VIEW_DEBUG_RAYS, EARLY_TERMINATION, ISO_REFINEMENT, MAX_RAY_REGIONS, REGION_CLUSTER}
 #import focal::bindings::{settings, scene, regions, depth_texture}
 #import focal::camera::{Ray, pixel_ray, scene_depth_t, jitter}
 #import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod}
@@ -472,55 +472,61 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
     var t_start = 3.4e38;
     var t_end = -3.4e38;
     var step = 3.4e38;
-    // (The loop runs alike in all lanes, so its loads stay uniform; a ray that misses a
-    // region's bounding sphere skips its planes, all of them when a whole SIMD group
+    // (The loops run alike in all lanes, so their loads stay uniform; a ray that misses a
+    // region's bounding sphere skips its planes, and one that misses the sphere around
+    // a run of REGION_CLUSTER regions skips the run: all of it when a whole SIMD group
     // misses.)
-    for (var i = 0u; i < scene.region_count; i++) {
-        if !meets_sphere(regions[i].bounds, ray.origin, ray.dir) {
+    for (var c = 0u; c < scene.region_count; c += REGION_CLUSTER) {
+        if !meets_sphere(regions[c].cluster, ray.origin, ray.dir) {
             continue;
         }
-        let iv = region_interval(regions[i], ray.origin, ray.dir);
-        let t0 = max(iv.x, 0.0);
-        if t0 < iv.y && n < MAX_RAY_REGIONS {
-            // One interval, less each hole's: intervals first..n of region i.
-            let first = n;
-            ids[n] = i;
-            t0s[n] = t0;
-            t1s[n] = iv.y;
-            n++;
+        for (var i = c; i < min(c + REGION_CLUSTER, scene.region_count); i++) {
+            if !meets_sphere(regions[i].bounds, ray.origin, ray.dir) {
+                continue;
+            }
+            let iv = region_interval(regions[i], ray.origin, ray.dir);
+            let t0 = max(iv.x, 0.0);
+            if t0 < iv.y && n < MAX_RAY_REGIONS {
+                // One interval, less each hole's: intervals first..n of region i.
+                let first = n;
+                ids[n] = i;
+                t0s[n] = t0;
+                t1s[n] = iv.y;
+                n++;
 #ifdef HAS_HOLES
-            let holes = regions[i].hole_count;
-            if holes > 0u {
-                for (var h = 0u; h < holes; h++) {
-                    n = cut_intervals(i, first, n, hole_interval(regions[i], h, ray.origin, ray.dir), &ids, &t0s, &t1s);
+                let holes = regions[i].hole_count;
+                if holes > 0u {
+                    for (var h = 0u; h < holes; h++) {
+                        n = cut_intervals(i, first, n, hole_interval(regions[i], h, ray.origin, ray.dir), &ids, &t0s, &t1s);
+                    }
+                    n = compact_intervals(first, n, &ids, &t0s, &t1s);
                 }
-                n = compact_intervals(first, n, &ids, &t0s, &t1s);
-            }
-            for (var e = first; e < n; e++) {
-                t_start = min(t_start, t0s[e]);
-                t_end = max(t_end, t1s[e]);
-            }
-#else
-            // (One interval: no loops over them, which llvmpipe ran for every region.)
-            t_start = min(t_start, t0);
-            t_end = max(t_end, iv.y);
-#endif
-            if n > first {
-                let ws = world_step(regions[i], ray.dir);
-                step = min(step, ws);
-                let factor = regions[i].native_step / (ws * regions[i].reference_length);
-                let mode = regions[i].mode;
-                var kind = select(0u, CLOSES, is_projection(mode) || mode == MODE_TWO_LEVEL);
-                kind |= select(0u, PAIRABLE, is_dvr_like(mode, regions[i].flags));
-#ifdef HAS_HOLES
                 for (var e = first; e < n; e++) {
-                    ratios[e] = factor;
-                    state[e] = kind;
+                    t_start = min(t_start, t0s[e]);
+                    t_end = max(t_end, t1s[e]);
                 }
 #else
-                ratios[first] = factor;
-                state[first] = kind;
+                // (One interval: no loops over them, which llvmpipe ran for every region.)
+                t_start = min(t_start, t0);
+                t_end = max(t_end, iv.y);
 #endif
+                if n > first {
+                    let ws = world_step(regions[i], ray.dir);
+                    step = min(step, ws);
+                    let factor = regions[i].native_step / (ws * regions[i].reference_length);
+                    let mode = regions[i].mode;
+                    var kind = select(0u, CLOSES, is_projection(mode) || mode == MODE_TWO_LEVEL);
+                    kind |= select(0u, PAIRABLE, is_dvr_like(mode, regions[i].flags));
+#ifdef HAS_HOLES
+                    for (var e = first; e < n; e++) {
+                        ratios[e] = factor;
+                        state[e] = kind;
+                    }
+#else
+                    ratios[first] = factor;
+                    state[first] = kind;
+#endif
+                }
             }
         }
     }

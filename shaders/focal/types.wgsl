@@ -39,6 +39,8 @@ struct Region {
     sphere: vec4<f32>,
     // World bounding sphere of the region's polyhedron (centre, radius).
     bounds: vec4<f32>,
+    // In the first region of each run of REGION_CLUSTER: a sphere around their bounds.
+    cluster: vec4<f32>,
     // Segmented regions: first part record, part count, label record.
     objects: vec4<u32>,
 }
@@ -108,3 +110,5 @@ const EARLY_TERMINATION: f32 = 0.99;
 const ISO_REFINEMENT: u32 = 8u;
 // Most regions one ray can cross.
 const MAX_RAY_REGIONS: u32 = 12u;
+// Regions the interval loop tests together (render::gpu_types::CLUSTER).
+const REGION_CLUSTER: u32 = 8u;

@@ -72,6 +72,23 @@ pub fn drawn_part(region: Region, look: &Appearance, volume: &Volume) -> Option<
     Some(region.cut_to_index_box(lo.max(Vec3::splat(-0.5)), hi.min(dims - 0.5)))
 }
 
+/// The order of points along a Z-order (Morton) curve through their bounding box, 10
+/// bits an axis: parts drawn in this order put neighbours in the same run of
+/// [`crate::render::gpu_types::CLUSTER`] regions, whose sphere the ray tests first.
+pub fn spatial_order(points: &[Vec3]) -> Vec<usize> {
+    let lo = points.iter().copied().fold(Vec3::splat(f32::INFINITY), Vec3::min);
+    let hi = points.iter().copied().fold(Vec3::splat(f32::NEG_INFINITY), Vec3::max);
+    let scale = 1023.0 / (hi - lo).max(Vec3::splat(1e-6));
+    let spread = |v: u32| (0..10).fold(0u32, |acc, b| acc | (((v >> b) & 1) << (3 * b)));
+    let code = |p: &Vec3| {
+        let q = ((*p - lo) * scale).round().clamp(Vec3::ZERO, Vec3::splat(1023.0)).as_uvec3();
+        spread(q.x) | (spread(q.y) << 1) | (spread(q.z) << 2)
+    };
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by_key(|&i| code(&points[i]));
+    order
+}
+
 /// Whether a part (rest polyhedron, dataset frame) meets the selection's box.
 pub fn meets(rest: &Polyhedron, selection_box: &[Plane]) -> bool {
     let mut planes = rest.planes.clone();
@@ -149,6 +166,25 @@ mod tests {
         let across =
             Polyhedron::cuboid(to_world.transform_point3(Vec3::splat(-0.5)), to_world.transform_point3(Vec3::new(9.5, 31.5, 31.5)));
         assert!(!meets(&left, &planes) && meets(&across, &planes));
+    }
+
+    #[test]
+    fn neighbours_come_together_in_spatial_order() {
+        // The centres of a 4×4×4 grid, listed x fastest: in Z order every run of 8 is
+        // one 2×2×2 block (its corners within one cell's span of each other).
+        let centres: Vec<Vec3> = (0..64).map(|i| Vec3::new((i % 4) as f32, ((i / 4) % 4) as f32, (i / 16) as f32)).collect();
+        let order = spatial_order(&centres);
+        let mut seen = order.clone();
+        seen.sort();
+        assert_eq!(seen, (0..64).collect::<Vec<_>>());
+        for run in order.chunks(8) {
+            let lo = run.iter().map(|&i| centres[i]).fold(Vec3::splat(9.0), Vec3::min);
+            let hi = run.iter().map(|&i| centres[i]).fold(Vec3::splat(-9.0), Vec3::max);
+            assert_eq!(hi - lo, Vec3::ONE, "run {run:?}");
+        }
+        assert_eq!(order[0], 0);
+        assert!(spatial_order(&[]).is_empty());
+        assert_eq!(spatial_order(&[Vec3::ONE]), vec![0]);
     }
 
     #[test]

@@ -19,7 +19,7 @@ use super::forces::{PartNow, Scale, Surroundings, Wrench, part_wrench};
 use super::joints::{build_joints, group_joints};
 use super::parts::Polyhedron;
 use super::points::explosion_points;
-use super::regions::{PlacedPart, drawn_part, meets, moving_as_one, part_regions, selection_box, selection_region};
+use super::regions::{PlacedPart, drawn_part, meets, moving_as_one, part_regions, selection_box, selection_region, spatial_order};
 use crate::dataset::{Dataset, GpuVolume, RegionSystems, SceneRegions};
 use crate::region::{Appearance, Keep, Region, SelectionWeight, box_planes};
 use crate::transfer::Lut;
@@ -286,7 +286,8 @@ pub fn apply_forces(
 /// Replaces each exploded dataset's region by its parts' regions (drawing the data less
 /// the selection) and the selection's own region (the box of its non-zero bricks, not
 /// moved, drawing the data in the selection), the parts first; parts that all move
-/// alike draw as one region ([`super::regions`]).
+/// alike draw as one region, the others in Z order of their rest centres
+/// ([`super::regions`]).
 pub fn exploded_regions(
     parts: Query<(&Part, &Transform, Option<&PartFade>)>,
     datasets: Query<(Entity, &Dataset, &Exploded, Option<&GpuVolume>, &GlobalTransform)>,
@@ -314,7 +315,10 @@ pub fn exploded_regions(
             continue;
         }
         let all: Vec<_> = parts.iter().filter(|(p, ..)| p.dataset == entity).collect();
-        let visible: Vec<_> = all.iter().filter(|(p, ..)| !p.hidden).collect();
+        // (In Z order of their rest centres: neighbours share a cluster of regions.)
+        let shown_parts: Vec<_> = all.iter().filter(|(p, ..)| !p.hidden).collect();
+        let centres: Vec<Vec3> = shown_parts.iter().map(|(p, ..)| p.rest.centroid()).collect();
+        let visible: Vec<_> = spatial_order(&centres).into_iter().map(|i| shown_parts[i]).collect();
         let fades: Vec<f32> = visible.iter().map(|(.., f)| f.map_or(1.0, |f| f.0)).collect();
         let grid = &shown(d, gpu).grid;
         let selection_box = x.selection.as_deref().and_then(selection_box);

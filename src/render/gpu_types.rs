@@ -147,6 +147,9 @@ pub struct GpuRegion {
     /// World bounding sphere of the region's polyhedron (centre, radius; an infinite
     /// radius when it has no vertices): rays that miss it skip the region's planes.
     pub bounds: Vec4,
+    /// In the first region of each run of [`CLUSTER`] (the ray's interval loop tests
+    /// them together): a sphere around the run's `bounds`; unused in the others.
+    pub cluster: Vec4,
     /// Segmented regions ([`mode::TWO_LEVEL`]): index of the first part record (the
     /// objects, then the rest), the number of parts, and the index of the label
     /// record (the label volume with, per code, up to four candidate objects + 1);
@@ -155,6 +158,13 @@ pub struct GpuRegion {
     /// degree of interest of a normalised sample `t`).
     pub objects: UVec4,
 }
+
+/// Regions the interval loop tests together (`REGION_CLUSTER` in
+/// `shaders/focal/types.wgsl`): a group of rays that misses the sphere around a run of
+/// this many consecutive regions skips them all. On llvmpipe the loop's cost per region
+/// (the sphere test and its bookkeeping), not the planes, was most of an exploded view's
+/// interval time: 60 of 70 ms a frame with 64 parts.
+pub const CLUSTER: usize = 8;
 
 /// Lens kinds, shapes (codes shared with `shaders/focal/lens.wgsl`).
 pub mod lens_codes {

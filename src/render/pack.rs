@@ -13,7 +13,7 @@ use glam::{Mat3, Mat4, UVec3, UVec4, Vec4};
 
 use crate::volume::pyramid::{MIP_LEVELS, half_dims};
 
-use super::gpu_types::{GpuRegion, context_power, mode, region_flags};
+use super::gpu_types::{CLUSTER, GpuRegion, context_power, mode, region_flags};
 use crate::context::Power;
 use crate::reference::prepare::{PreparedLookup, PreparedRegion};
 use crate::region::{Mode, RenderScene};
@@ -203,6 +203,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.regions.push(region);
     }
     out.region_count = out.regions.len() as u32;
+    set_clusters(&mut out.regions);
     // Records the ray does not traverse: the parts and labels of segmented regions, the
     // selections of weighted ones.
     for (index, p, slots) in segmented {
@@ -544,8 +545,33 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
         ),
         sphere: p.sphere.0.extend(p.sphere.1),
         bounds: polyhedron_sphere(&p.region.planes),
+        cluster: Vec4::ZERO,
         objects: UVec4::ZERO,
     }
+}
+
+/// The `cluster` sphere of the first region of every run of [`CLUSTER`] in `regions`
+/// (the regions the ray traverses).
+fn set_clusters(regions: &mut [GpuRegion]) {
+    for run in regions.chunks_mut(CLUSTER) {
+        let spheres: Vec<Vec4> = run.iter().map(|r| r.bounds).collect();
+        run[0].cluster = sphere_around(&spheres);
+    }
+}
+
+/// A sphere (centre, radius) around the spheres `spheres`: the centre of their bounding
+/// box, the farthest reach from it, a little more for rounding; infinite when one is
+/// (or there are none).
+pub fn sphere_around(spheres: &[Vec4]) -> Vec4 {
+    let infinite = Vec4::new(0.0, 0.0, 0.0, f32::MAX);
+    if spheres.is_empty() || spheres.iter().any(|s| !s.is_finite() || s.w >= f32::MAX) {
+        return infinite;
+    }
+    let lo = spheres.iter().map(|s| s.truncate() - s.w).fold(glam::Vec3::splat(f32::INFINITY), glam::Vec3::min);
+    let hi = spheres.iter().map(|s| s.truncate() + s.w).fold(glam::Vec3::splat(f32::NEG_INFINITY), glam::Vec3::max);
+    let center = (lo + hi) * 0.5;
+    let radius = spheres.iter().map(|s| s.truncate().distance(center) + s.w).fold(0.0, f32::max);
+    center.extend(radius * (1.0 + 1e-4) + 1e-3)
 }
 
 /// A sphere around the convex polyhedron `planes` (the centre of its vertices' bounding
@@ -583,6 +609,29 @@ mod tests {
             native_step,
             ..Default::default()
         }
+    }
+
+    #[test]
+    fn every_run_of_regions_has_a_sphere_around_its_own() {
+        // 19 regions: runs 0..8, 8..16, 16..19, each with its sphere in its first record.
+        let mut regions: Vec<GpuRegion> = (0..19)
+            .map(|i| GpuRegion { bounds: Vec4::new(i as f32 * 10.0, (i % 3) as f32, 0.0, 1.0 + (i % 4) as f32), ..Default::default() })
+            .collect();
+        set_clusters(&mut regions);
+        for (k, run) in regions.chunks(CLUSTER).enumerate() {
+            let c = run[0].cluster;
+            for r in run {
+                let b = r.bounds;
+                assert!(b.truncate().distance(c.truncate()) + b.w <= c.w, "run {k}: {b} outside {c}");
+            }
+        }
+        assert_eq!(regions.chunks(CLUSTER).count(), 3);
+        // Tight for two spheres on a line: centres 0 and 10, radii 1 and 3 → [−1, 13].
+        let s = sphere_around(&[Vec4::new(0.0, 0.0, 0.0, 1.0), Vec4::new(10.0, 0.0, 0.0, 3.0)]);
+        assert!((s.truncate() - Vec3::new(6.0, 0.0, 0.0)).length() < 1e-5 && (s.w - 7.0).abs() < 0.01, "{s}");
+        // An infinite member (a region without vertices) makes the run infinite.
+        assert_eq!(sphere_around(&[Vec4::new(0.0, 0.0, 0.0, f32::MAX), Vec4::ONE]).w, f32::MAX);
+        assert_eq!(sphere_around(&[]).w, f32::MAX);
     }
 
     #[test]

@@ -51,3 +51,47 @@ pub fn an_exploded_head_matches_the_reference(gpu: &mut Gpu) {
     assert!(red > 10, "the arteries show: {red} pixels");
     gpu.clear();
 }
+
+/// 18 parts (a 3×3×2 grid) exploded: the ray tests them in runs of
+/// `render::gpu_types::CLUSTER` (8, 8 and 2, with the selection's region) behind the
+/// sphere around each run; every part must still be drawn where the reference draws it.
+pub fn eighteen_exploded_parts_match_the_reference(gpu: &mut Gpu) {
+    let ct = head();
+    let skin = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap());
+    gpu.clear();
+    let labels = phantom::head::generate(64).unwrap().labels;
+    let ids = [phantom::head::label::ARTERIES as u32].into_iter().collect();
+    let selection = SelectionVolume::from_labels(&labels, &ids).unwrap();
+    let world = gpu.off.world_mut();
+    let data = world.spawn((Dataset::new(ct.clone(), skin), Transform::default(), Exploded::around(&selection))).id();
+    let (lo, hi) = ct.grid.world_bounds();
+    let cuts = |pieces: Vec<focal::explode::parts::Polyhedron>, axis: Vec3, n: usize| -> Vec<focal::explode::parts::Polyhedron> {
+        let (a, b) = (lo.dot(axis), hi.dot(axis));
+        (1..n).fold(pieces, |pieces, k| {
+            let offset = a + (b - a) * k as f32 / n as f32;
+            pieces
+                .into_iter()
+                .flat_map(|p| match p.split(Plane { normal: axis, offset }) {
+                    Some((x, y)) => vec![x, y],
+                    None => vec![p],
+                })
+                .collect()
+        })
+    };
+    let grid = cuts(cuts(cuts(vec![volume_polyhedron(&ct).unwrap()], Vec3::X, 3), Vec3::Y, 3), Vec3::Z, 2);
+    assert_eq!(grid.len(), 18);
+    for rest in grid {
+        spawn_part(world, Part::new(data, rest), Transform::default());
+    }
+    let cam = framed(&ct, View::Oblique, true);
+    gpu.off.set_camera(&cam);
+    // (A frame first: the parts get their bodies.)
+    gpu.off.capture().unwrap();
+    gpu.off.world_mut().get_mut::<Exploded>(data).unwrap().coefficients.degree = 1.0;
+    step(gpu.off.world_mut(), 300);
+    let apart = gpu.off.capture().unwrap();
+    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
+    assert!(scene.regions.len() >= 19, "{} regions: the parts apart, each its own", scene.regions.len());
+    assert_matches("eighteen_parts_apart", &apart, &render(&scene, &cam, SIZE, SIZE).unwrap().to_image().unwrap());
+    gpu.clear();
+}
