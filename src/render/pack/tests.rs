@@ -1,0 +1,249 @@
+//! Tests of the packing: region records, clusters, selections' brick kinds, overlaps
+//! and the march bound.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+use super::*;
+use crate::region::{Appearance, Plane, Region};
+use crate::transfer::presets;
+use crate::volume::phantom;
+
+fn region(voxel_to_world: Mat3, dims: f32, native_step: f32) -> GpuRegion {
+    let world_to_voxel = voxel_to_world.inverse();
+    GpuRegion {
+        world_to_voxel: Mat4::from_mat3(world_to_voxel),
+        // Native = world here, so world→native per index is the identity after the
+        // world→voxel map: to_native = index_to_native · world_to_voxel.
+        to_native: Mat4::from_mat3(voxel_to_world * world_to_voxel),
+        dims: Vec4::new(dims, dims, dims, 255.0),
+        native_step,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn every_run_of_regions_has_a_sphere_around_its_own() {
+    // 19 regions: runs 0..8, 8..16, 16..19, each with its sphere in its first record.
+    let mut regions: Vec<GpuRegion> = (0..19)
+        .map(|i| GpuRegion { bounds: Vec4::new(i as f32 * 10.0, (i % 3) as f32, 0.0, 1.0 + (i % 4) as f32), ..Default::default() })
+        .collect();
+    set_clusters(&mut regions);
+    for (k, run) in regions.chunks(CLUSTER).enumerate() {
+        let c = run[0].cluster;
+        for r in run {
+            let b = r.bounds;
+            assert!(b.truncate().distance(c.truncate()) + b.w <= c.w, "run {k}: {b} outside {c}");
+        }
+    }
+    assert_eq!(regions.chunks(CLUSTER).count(), 3);
+    // Tight for two spheres on a line: centres 0 and 10, radii 1 and 3 → [−1, 13].
+    let s = sphere_around(&[Vec4::new(0.0, 0.0, 0.0, 1.0), Vec4::new(10.0, 0.0, 0.0, 3.0)]);
+    assert!((s.truncate() - Vec3::new(6.0, 0.0, 0.0)).length() < 1e-5 && (s.w - 7.0).abs() < 0.01, "{s}");
+    // An infinite member (a region without vertices) makes the run infinite.
+    assert_eq!(sphere_around(&[Vec4::new(0.0, 0.0, 0.0, f32::MAX), Vec4::ONE]).w, f32::MAX);
+    assert_eq!(sphere_around(&[]).w, f32::MAX);
+}
+
+#[test]
+fn selection_bricks_by_kind() {
+    use crate::volume::BrickGrid;
+    // Bricks: none selected, all, a mix, one middle code, and a 17th (second word).
+    let mut bricks = BrickGrid { size: 8, dims: glam::UVec3::new(17, 1, 1), min: vec![0; 17], max: vec![0; 17] };
+    (bricks.min[1], bricks.max[1]) = (255, 255);
+    (bricks.min[2], bricks.max[2]) = (0, 255);
+    (bricks.min[3], bricks.max[3]) = (10, 10);
+    (bricks.min[16], bricks.max[16]) = (0, 3);
+    let words = constant_bricks(&bricks, 255);
+    assert_eq!(words.len(), 2);
+    let kind = |i: usize| (words[i / 16] >> (2 * (i % 16))) & 3;
+    assert_eq!((kind(0), kind(1), kind(2), kind(3), kind(4), kind(16)), (0, 1, 2, 2, 0, 2));
+}
+
+#[test]
+fn march_bound_by_hand() {
+    // 32³ unit voxels, half-voxel steps: diagonal √3·32, smallest step bounded below
+    // by 0.5/‖I‖_F = 0.5/√3, so 192 samples, + 3 per region + 2.
+    let cube = region(Mat3::IDENTITY, 32.0, 0.5);
+    assert_eq!(march_bound(&[cube], None), 197);
+    // Voxels twice as long in x: diagonal |(64, 32, 32)| = 78.38…, same steps:
+    // 78.38·2√3 = 271.5 → 272, + 5.
+    let long = region(Mat3::from_diagonal(Vec3::new(2.0, 1.0, 1.0)), 32.0, 0.5);
+    assert_eq!(march_bound(&[long], None), 277);
+    // Two regions: chords add up, the smaller step counts, 3 per region.
+    let fine = region(Mat3::IDENTITY, 32.0, 0.25);
+    assert_eq!(march_bound(&[cube, fine], None), 384 + 384 + 8);
+    assert_eq!(march_bound(&[], None), 2);
+    // Two halves of one box: the chords of a ray through both add up to at most the
+    // box's diagonal, 32√3: 192 samples, + 3 per region + 2.
+    let diagonal = 32.0 * 3f32.sqrt();
+    assert_eq!(march_bound(&[cube, cube], Some(diagonal)), 192 + 6 + 2);
+    // The extent only ever lowers the bound.
+    assert_eq!(march_bound(&[cube], Some(1e6)), 197);
+    // Each hole splits an interval: 3 more.
+    let holed = GpuRegion { hole_count: 2, ..cube };
+    assert_eq!(march_bound(&[holed], None), 197 + 6);
+}
+
+#[test]
+fn march_bound_exceeds_the_samples_of_any_ray() {
+    // A rotated, anisotropic volume: every ray's chord / step (+1) stays below.
+    let m = Mat3::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.7) * Mat3::from_diagonal(Vec3::new(0.5, 1.0, 3.0));
+    let r = region(m, 40.0, 0.5);
+    let bound = march_bound(&[r], None) as f32;
+    let lo = Vec3::splat(-0.5);
+    let hi = Vec3::splat(39.5);
+    let mut longest = 0.0f32;
+    for i in 0..2000 {
+        // Directions on a Fibonacci sphere, rays through the volume's centre.
+        let z = 1.0 - 2.0 * (i as f32 + 0.5) / 2000.0;
+        let a = i as f32 * 2.399_963;
+        let dir = Vec3::new((1.0 - z * z).sqrt() * a.cos(), (1.0 - z * z).sqrt() * a.sin(), z);
+        let centre = m * Vec3::splat(19.5);
+        let (qo, qd) = (m.inverse() * (centre - dir * 1e4), m.inverse() * dir);
+        // Slab test in voxel space.
+        let (t0, t1) = (0..3).fold((f32::MIN, f32::MAX), |(a, b), k| {
+            let (u, v) = ((lo[k] - qo[k]) / qd[k], (hi[k] - qo[k]) / qd[k]);
+            (a.max(u.min(v)), b.min(u.max(v)))
+        });
+        let world_step = r.native_step / (Mat3::from_mat4(r.to_native) * dir).length();
+        longest = longest.max((t1 - t0) / world_step + 1.0);
+    }
+    assert!(longest > 0.5 * bound, "the bound is far too loose: {longest} of {bound}");
+    assert!(longest <= bound, "a ray takes {longest} samples, more than the bound {bound}");
+}
+
+#[test]
+fn overlapping_regions_need_the_multi_region_code_touching_ones_do_not() {
+    use super::super::gpu_types::features;
+    let v = Arc::new(phantom::sphere(16, 5.0).unwrap());
+    let tf = presets::builtin("grayscale_ramp").unwrap();
+    let mut scene = RenderScene::single(v.clone(), Appearance::new(Mode::Dvr, tf));
+    let whole = Region::volume_box(&v.grid, 0, 0);
+    let centre = (v.grid.world_bounds().0 + v.grid.world_bounds().1) * 0.5;
+    // Two halves of the volume touch along a plane: no overlap.
+    scene.regions =
+        vec![whole.clone().clipped(Plane::through(centre, glam::Vec3::X)), whole.clone().clipped(Plane::through(centre, -glam::Vec3::X))];
+    let packed = pack(&scene, 2048).unwrap();
+    assert_eq!(packed.region_count, 2);
+    assert_eq!(packed.features & (features::MULTI_REGION | features::DVR_PAIRS | features::HOLES), 0);
+    // The whole volume and one half overlap: two DVR regions, the pair loop.
+    scene.regions[0] = whole.clone();
+    assert_eq!(pack(&scene, 2048).unwrap().features & (features::MULTI_REGION | features::DVR_PAIRS), features::DVR_PAIRS);
+    // A third region over both, or a MIP region in the pair: sample by sample.
+    let mut three = scene.clone();
+    three.regions.push(whole.clone());
+    assert_ne!(pack(&three, 2048).unwrap().features & features::MULTI_REGION, 0);
+    let mut mixed = scene.clone();
+    mixed.appearances.push(Appearance::new(Mode::Mip, presets::builtin("grayscale_ramp").unwrap()));
+    mixed.regions[1].appearance = 1;
+    assert_ne!(pack(&mixed, 2048).unwrap().features & features::MULTI_REGION, 0);
+    // Unless that half is a hole in the whole (a clip window and its content).
+    let (lo, hi) = v.grid.world_bounds();
+    let half = crate::region::box_planes(&glam::Affine3A::IDENTITY, glam::Vec3::new(centre.x, lo.y - 1.0, lo.z - 1.0), hi + 1.0);
+    scene.regions[0].holes.push(std::array::from_fn(|i| half[i]));
+    let packed = pack(&scene, 2048).unwrap();
+    assert_eq!(packed.features & (features::MULTI_REGION | features::DVR_PAIRS), 0);
+    assert_eq!((packed.regions[0].hole_count, packed.regions[0].hole_offset), (1, 6));
+    assert_ne!(packed.features & features::HOLES, 0, "the hole code is compiled in");
+    // A hole that holds only part of the common part leaves an overlap.
+    let small = crate::region::box_planes(&glam::Affine3A::IDENTITY, centre, hi + 1.0);
+    scene.regions[0].holes[0] = std::array::from_fn(|i| small[i]);
+    assert_ne!(pack(&scene, 2048).unwrap().features & features::DVR_PAIRS, 0);
+}
+
+#[test]
+fn a_region_over_the_empty_part_of_a_box_needs_no_overlap_code() {
+    use super::super::gpu_types::features;
+    // A sphere of radius 6 mm in a 64 mm box at 1 mm: the ramp makes the zeros around
+    // it transparent, so only the bricks at the centre are visible.
+    let v = Arc::new(phantom::sphere(64, 6.0).unwrap());
+    let ramp = presets::builtin("grayscale_ramp").unwrap();
+    let mut scene = RenderScene::single(v.clone(), Appearance::new(Mode::Dvr, ramp.clone()));
+    let corner = |lo: f32, hi: f32| {
+        let planes = crate::region::box_planes(&glam::Affine3A::IDENTITY, glam::Vec3::splat(lo), glam::Vec3::splat(hi));
+        Region { planes, ..Region::volume_box(&v.grid, 0, 1) }
+    };
+    scene.appearances.push(Appearance::new(Mode::Mip, ramp.clone()));
+    // A MIP region in a corner of the box, after the dataset: the dataset is
+    // transparent there, the sample is the window's.
+    scene.regions.push(corner(18.0, 30.0));
+    let bits = |s: &RenderScene| pack(s, 2048).unwrap().features & (features::MULTI_REGION | features::DVR_PAIRS);
+    assert_eq!(bits(&scene), 0);
+    // Over the sphere it needs the general code.
+    scene.regions[1] = corner(-4.0, 4.0);
+    assert_eq!(bits(&scene), features::MULTI_REGION);
+    // Before the dataset in region order, the MIP region would lose its samples to
+    // the dataset's transparent ones: it needs the code too.
+    scene.regions.swap(0, 1);
+    scene.regions[0] = corner(18.0, 30.0);
+    assert_eq!(bits(&scene), features::MULTI_REGION);
+    // Two DVR regions over the sphere: the pair loop.
+    scene.regions = vec![Region::volume_box(&v.grid, 0, 0), Region { appearance: 0, ..corner(-4.0, 4.0) }];
+    assert_eq!(bits(&scene), features::DVR_PAIRS);
+}
+
+#[test]
+fn packs_regions_planes_luts_and_the_atlas() {
+    let v = Arc::new(phantom::sphere(16, 5.0).unwrap());
+    let tf = presets::builtin("grayscale_ramp").unwrap();
+    let mut scene = RenderScene::single(v.clone(), Appearance::new(Mode::Mip, tf.clone()));
+    scene.regions.push(Region::volume_box(&v.grid, 0, 0).clipped(Plane::through(glam::Vec3::ZERO, glam::Vec3::X)));
+    let packed = pack(&scene, 2048).unwrap();
+    assert_eq!(packed.regions.len(), 2);
+    assert_eq!(packed.volumes, vec![0]);
+    // The volume and its mip levels 8³, 4³, 2³ stacked along z.
+    assert_eq!(packed.atlas.size, UVec3::new(16, 16, 30));
+    assert!(packed.mips);
+    assert_eq!(packed.regions[1].mip_count, 3);
+    assert_eq!(
+        packed.regions[1].mips,
+        [glam::Vec4::new(0.0, 0.0, 16.0, 1.0), glam::Vec4::new(0.0, 0.0, 24.0, 1.0), glam::Vec4::new(0.0, 0.0, 28.0, 1.0)]
+    );
+    assert_eq!((packed.regions[0].plane_offset, packed.regions[0].plane_count), (0, 6));
+    assert_eq!((packed.regions[1].plane_offset, packed.regions[1].plane_count), (6, 7));
+    assert_eq!(packed.regions[0].mode, mode::MIP);
+    // 8-bit volume: a 256-texel table per region, both in the first atlas row.
+    assert_eq!((packed.regions[1].lut_offset, packed.regions[1].lut_width), (256, 256));
+    assert_eq!(packed.lut.len(), LUT_ATLAS_WIDTH as usize);
+    assert_eq!(packed.regions[0].dims, glam::Vec4::new(16.0, 16.0, 16.0, 255.0));
+    use crate::render::gpu_types::features as f;
+    assert_eq!(packed.features, f::PROJECTION | f::SHADING | f::MULTI_REGION);
+}
+
+#[test]
+fn shelf_layout_stacks_then_starts_columns() {
+    let a = atlas_layout(&[UVec3::new(4, 5, 6), UVec3::new(3, 2, 4), UVec3::new(2, 2, 5)], 10).unwrap();
+    // 6 + 4 = 10 fits the first column; the third box starts a column at x = 4.
+    assert_eq!(a.offsets, vec![UVec3::ZERO, UVec3::new(0, 0, 6), UVec3::new(4, 0, 0)]);
+    assert_eq!(a.size, UVec3::new(6, 5, 10));
+    assert!(atlas_layout(&[UVec3::new(11, 1, 1)], 10).is_none());
+    assert!(atlas_layout(&[UVec3::splat(8), UVec3::splat(8)], 10).is_none());
+}
+
+#[test]
+fn volumes_beyond_the_atlas_are_reported() {
+    let tf = presets::builtin("grayscale_ramp").unwrap();
+    let mut scene = RenderScene::default();
+    scene.appearances.push(Appearance::new(Mode::Dvr, tf));
+    for i in 0..3 {
+        let v = Arc::new(phantom::sphere(8, 2.0).unwrap());
+        scene.regions.push(Region::volume_box(&v.grid, i, 0));
+        scene.volumes.push(v);
+    }
+    // A 16³ atlas holds two 8³ volumes stacked, not three (16 along x also fails).
+    let packed = pack(&scene, 16).unwrap();
+    assert_eq!(packed.regions.len(), 3, "three volumes fit as two columns");
+    // With their mip chains (15 texels deep each) only two would: the chains go.
+    assert!(!packed.mips && packed.regions.iter().all(|r| r.mip_count == 0));
+    let two = RenderScene { volumes: scene.volumes[..2].to_vec(), regions: scene.regions[..2].to_vec(), ..scene.clone() };
+    assert!(pack(&two, 16).unwrap().mips);
+    let packed = pack(&scene, 12).unwrap();
+    assert_eq!(packed.regions.len(), 1);
+    assert_eq!(packed.dropped.len(), 2);
+    assert_eq!(packed.region_slots.iter().filter(|s| s.is_none()).count(), 2);
+    assert_eq!(packed.region_slots.iter().flatten().count(), packed.regions.len());
+    // DVR regions carry their occupancy bits.
+    assert!(packed.regions.iter().all(|r| r.flags & region_flags::OCCUPANCY != 0));
+}
