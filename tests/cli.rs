@@ -1,4 +1,4 @@
-//! The `focal` binary: `info --json` and `render --cpu` end to end.
+//! The `focal` binary: `info --json`, `render --cpu` and `bench --explode --json` end to end.
 
 mod common;
 
@@ -52,4 +52,26 @@ fn render_cpu_writes_a_png() {
     assert_eq!(img.get_pixel(0, 0)[0], 0);
     let bad = focal().args(["render", "phantom:sphere", "--cpu", "--mode", "volumetric"]).output().unwrap();
     assert!(!bad.status.success());
+}
+
+#[test]
+fn bench_explode_reports_table_1_as_percentages_of_the_plain_frame_rate() {
+    // The paper's table 1, small: 1 and 2 parts, at rest and exploded, against the plain
+    // ray caster in the same run (on the GPU: lavapipe where there is none).
+    let out = focal()
+        .args(["bench", "--explode", "--parts", "1,2", "--frames", "1", "--size", "32x32", "--resolution", "32", "--json"])
+        .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).unwrap();
+    let configs: Vec<&str> = rows.iter().map(|r| r["config"].as_str().unwrap()).collect();
+    assert_eq!(configs, ["plain ray caster", "1 part, at rest", "1 part, exploded", "2 parts, at rest", "2 parts, exploded"]);
+    for r in &rows {
+        assert_eq!(r["group"], "explode");
+        assert_eq!(r["baseline"], "plain ray caster");
+        let (ratio, percent) = (r["ratio"].as_f64().unwrap(), r["frame_rate_percent"].as_f64().unwrap());
+        assert!(ratio > 0.0 && (percent * ratio - 100.0).abs() < 1e-6, "{r}");
+    }
+    assert_eq!(rows[0]["frame_rate_percent"], 100.0);
 }

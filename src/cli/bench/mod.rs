@@ -241,6 +241,14 @@ impl Bench {
 }
 
 /// Rows of a group timed by [`Bench::interleaved`], against its first configuration.
+impl Row {
+    /// The frame rate as a percentage of the baseline's (the paper's table 1 reports
+    /// it so): 100 / ratio.
+    fn frame_rate_percent(&self) -> f64 {
+        100.0 / self.ratio.max(1e-9)
+    }
+}
+
 fn push_group(rows: &mut Vec<Row>, group: &'static str, names: &[&str], ms: &[f64], base_note: &str, note: &str) {
     let base = names[0].to_string();
     for (i, (name, t)) in names.iter().zip(ms).enumerate() {
@@ -436,12 +444,23 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
 
     if args.json {
         let v: Vec<_> =
-            rows.iter().map(|r| json!({"group": r.group, "config": r.config, "ms_per_frame": r.ms, "baseline": r.baseline, "ratio": r.ratio, "note": r.note})).collect();
+            rows
+            .iter()
+            .map(|r| json!({"group": r.group, "config": r.config, "ms_per_frame": r.ms, "baseline": r.baseline, "ratio": r.ratio, "frame_rate_percent": r.frame_rate_percent(), "note": r.note}))
+            .collect();
         println!("{}", serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?);
     } else {
         for r in &rows {
             let note = if r.note.is_empty() { String::new() } else { format!("  ({})", r.note) };
-            println!("{:<12} {:<16} {:>9.1} ms/frame  ×{:.2} vs {}{note}", r.group, r.config, r.ms, r.ratio, r.baseline);
+            println!(
+                "{:<12} {:<16} {:>9.1} ms/frame  ×{:.2} vs {} ({:.0} % of its frame rate){note}",
+                r.group,
+                r.config,
+                r.ms,
+                r.ratio,
+                r.baseline,
+                r.frame_rate_percent()
+            );
         }
     }
     Ok(())
