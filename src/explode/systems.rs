@@ -19,7 +19,9 @@ use super::forces::{PartNow, Scale, Surroundings, Wrench, part_wrench};
 use super::joints::{build_joints, group_joints};
 use super::parts::Polyhedron;
 use super::points::explosion_points;
-use super::regions::{PlacedPart, drawn_part, meets, moving_as_one, part_regions, selection_box, selection_region, spatial_order};
+use super::regions::{
+    PlacedPart, drawn_part, holds_selection, moving_as_one, part_regions, selection_box, selection_region, spatial_order,
+};
 use crate::dataset::{Dataset, GpuVolume, RegionSystems, SceneRegions};
 use crate::region::{Appearance, Keep, Region, SelectionWeight, box_planes};
 use crate::transfer::Lut;
@@ -342,7 +344,7 @@ pub fn exploded_regions(
         // part (one look per opacity step).
         let mut looks: Vec<((u32, bool), usize)> = Vec::new();
         for ((r, o), p) in regions.iter_mut().zip(&fades).zip(&placed) {
-            let near = selection_box.as_ref().is_some_and(|b| meets(p.rest, b));
+            let near = x.selection.as_deref().is_some_and(|s| holds_selection(p.rest, s));
             let key = ((o * 1000.0).round() as u32, near);
             r.appearance = match looks.iter().find(|l| l.0 == key) {
                 Some(l) => l.1,
