@@ -17,8 +17,22 @@ struct View {
 const BEVY_FULLSCREEN: &str = "#define_import_path bevy_core_pipeline::fullscreen_vertex_shader
 struct FullscreenVertexOutput { @builtin(position) position: vec4<f32>, @location(0) uv: vec2<f32> }";
 
-const MODULES: [&str; 11] =
-    ["types", "bindings", "camera", "regions", "sampling", "lens", "transfer", "shading", "compositing", "context", "selection"];
+const MODULES: [&str; 14] = [
+    "types",
+    "bindings",
+    "camera",
+    "regions",
+    "sampling",
+    "lens",
+    "transfer",
+    "shading",
+    "compositing",
+    "context",
+    "selection",
+    "samples",
+    "segments",
+    "two_level",
+];
 
 fn read(rel: &str) -> String {
     std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))

@@ -13,7 +13,7 @@ pub const RAYCAST: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b
 pub const FEATURE: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a12");
 
 /// (fixed handle, file name, source) of every shader.
-const SHADERS: [(Handle<Shader>, &str, &str); 13] = [
+const SHADERS: [(Handle<Shader>, &str, &str); 16] = [
     (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a01"), "shaders/focal/types.wgsl", include_str!("../../shaders/focal/types.wgsl")),
     (
         uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a02"),
@@ -44,6 +44,17 @@ const SHADERS: [(Handle<Shader>, &str, &str); 13] = [
         uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a0b"),
         "shaders/focal/selection.wgsl",
         include_str!("../../shaders/focal/selection.wgsl"),
+    ),
+    (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a0c"), "shaders/focal/samples.wgsl", include_str!("../../shaders/focal/samples.wgsl")),
+    (
+        uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a0d"),
+        "shaders/focal/segments.wgsl",
+        include_str!("../../shaders/focal/segments.wgsl"),
+    ),
+    (
+        uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a0e"),
+        "shaders/focal/two_level.wgsl",
+        include_str!("../../shaders/focal/two_level.wgsl"),
     ),
     (RAYCAST, "shaders/raycast.wgsl", include_str!("../../shaders/raycast.wgsl")),
     (FEATURE, "shaders/feature.wgsl", include_str!("../../shaders/feature.wgsl")),

@@ -1,0 +1,164 @@
+#define_import_path focal::samples
+
+// One sample of a region along the ray, by mode (reference: src/reference/trace.rs):
+// DVR (labels, gradient-modulated and context-preserving DVR included, weighted by a
+// selection in exploded views), the iso-surface between two samples, and a projection's
+// value when its region closes.
+
+#import focal::types::{Region, MODE_TWO_LEVEL, MODE_OFF, MODE_MIP, MODE_MIN_IP, MODE_X_RAY, MODE_GRADIENT_DVR, MODE_ISO, MODE_CONTEXT, REGION_LABELS, REGION_SHADING, REGION_LAMBDA, ISO_REFINEMENT}
+#import focal::bindings::{settings, scene}
+#import focal::camera::Ray
+#import focal::regions::to_voxel
+#import focal::sampling::{trilinear, nearest_code, index_gradient}
+#import focal::transfer::{classify, classify_label, classify_lambda, correct_opacity}
+#import focal::shading::{shade, shade_with, blinn_phong}
+#import focal::context::{context_opacity, eye_distance}
+#import focal::compositing::composite
+#import focal::selection::weight_at
+
+fn is_projection(mode: u32) -> bool {
+    return mode == MODE_MIP || mode == MODE_MIN_IP || mode == MODE_X_RAY;
+}
+
+// Shaded colour of a DVR or iso sample at q.
+fn shaded(r: Region, c: vec3<f32>, q: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+#ifdef HAS_SHADING
+    if (r.flags & REGION_SHADING) != 0u {
+        let g = (r.normal_matrix * vec4(index_gradient(r, q, scene.lut_atlas_width), 0.0)).xyz;
+        return shade(c, g, dir, settings.light, r.shading, true);
+    }
+#endif
+    return c;
+}
+
+// One DVR (label, gradient-modulated or context-preserving) sample at q, ray parameter
+// t, composited under acc. The gradient is fetched once for shading and modulation.
+fn dvr_sample(r: Region, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
+    var rgba: vec4<f32>;
+    var v = 0.0;
+#ifdef HAS_LABELS
+    if (r.flags & REGION_LABELS) != 0u {
+        rgba = classify_label(r, nearest_code(r, q), scene.lut_atlas_width);
+    } else {
+        v = trilinear(r, q);
+        rgba = classify(r, v, scene.lut_atlas_width);
+    }
+#else
+    v = trilinear(r, q);
+    rgba = classify(r, v, scene.lut_atlas_width);
+#endif
+    return dvr_classified(r, q, v, rgba, ratio, ray, t, acc);
+}
+
+// dvr_sample after classification: value v (0 for labels) gave rgba.
+fn dvr_classified(r: Region, q: vec3<f32>, v: f32, rgba: vec4<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
+    var a = rgba.a;
+#ifdef HAS_SELECTION
+    a *= weight_at(q);
+#endif
+    if a <= 0.0 {
+        return acc;
+    }
+    var alpha = correct_opacity(a, ratio);
+    var c = rgba.rgb;
+    let labels = (r.flags & REGION_LABELS) != 0u;
+    var needs_gradient = false;
+#ifdef HAS_GRADIENT_MODULATION
+    needs_gradient = needs_gradient || (r.mode == MODE_GRADIENT_DVR && !labels);
+#endif
+#ifdef HAS_CONTEXT
+    needs_gradient = needs_gradient || (r.mode == MODE_CONTEXT && !labels);
+#endif
+#ifdef HAS_SHADING
+    needs_gradient = needs_gradient || (r.flags & REGION_SHADING) != 0u;
+#endif
+    if needs_gradient {
+        let gi = index_gradient(r, q, scene.lut_atlas_width);
+        let g = (r.normal_matrix * vec4(gi, 0.0)).xyz;
+        let magnitude = min(length(gi) / r.gradient_max, 1.0);
+#ifdef HAS_GRADIENT_MODULATION
+        if r.mode == MODE_GRADIENT_DVR && !labels {
+            alpha *= magnitude;
+        }
+#endif
+        // The Blinn-Phong terms serve both the shading and s(P) of equation 5.
+        let shading = (r.flags & REGION_SHADING) != 0u;
+        var terms = vec2(1.0, 0.0);
+        if shading || r.mode == MODE_CONTEXT {
+            terms = blinn_phong(g, ray.dir, settings.light, r.shading);
+        }
+#ifdef HAS_CONTEXT
+        if r.mode == MODE_CONTEXT && !labels {
+            var lambda = vec2(1.0);
+            if (r.flags & REGION_LAMBDA) != 0u {
+                lambda = classify_lambda(r, v, scene.lut_atlas_width);
+            }
+            let eye = eye_distance(r, ray.origin, ray.dir, t);
+            alpha = context_opacity(r, alpha, magnitude, clamp(terms.x + terms.y, 0.0, 1.0), eye, acc.a, lambda);
+        }
+#endif
+#ifdef HAS_SHADING
+        if shading {
+            c = shade_with(c, terms);
+        }
+#endif
+    }
+    return composite(acc, c, alpha);
+}
+
+// The iso-surface between two samples, refined by bisection (reference: trace::refine).
+fn refine_iso(r: Region, ray: Ray, ta_in: f32, va: f32, tb_in: f32) -> f32 {
+    var ta = ta_in;
+    var tb = tb_in;
+    let below = va < 0.0;
+    for (var i = 0u; i < ISO_REFINEMENT; i++) {
+        let tm = 0.5 * (ta + tb);
+        let v = trilinear(r, to_voxel(r, ray.origin + ray.dir * tm)) - r.iso;
+        if (v < 0.0) == below {
+            ta = tm;
+        } else {
+            tb = tm;
+        }
+    }
+    return 0.5 * (ta + tb);
+}
+
+// The iso-surface at voxel position q, shaded and opaque (reference: trace::iso_surface).
+fn iso_surface(r: Region, q: vec3<f32>, dir: vec3<f32>, acc: vec4<f32>) -> vec4<f32> {
+    let rgba = classify(r, r.iso, scene.lut_atlas_width);
+    return composite(acc, shaded(r, rgba.rgb, q, dir), 1.0);
+}
+
+fn iso_hit(r: Region, ray: Ray, tp: f32, vp: f32, t: f32, acc: vec4<f32>) -> vec4<f32> {
+    let th = refine_iso(r, ray, tp, vp, t);
+    return iso_surface(r, to_voxel(r, ray.origin + ray.dir * th), ray.dir, acc);
+}
+
+// Whether a region composites every sample at once (DVR, gradient-modulated and
+// context-preserving DVR, label volumes): two of them can share one tight loop.
+fn is_dvr_like(mode: u32, flags: u32) -> bool {
+    if mode == MODE_TWO_LEVEL || mode == MODE_OFF {
+        return false;
+    }
+    return (flags & REGION_LABELS) != 0u || !(is_projection(mode) || mode == MODE_ISO);
+}
+
+fn projected(mode: u32, vmax: f32, vmin: f32, vsum: f32, count: u32) -> f32 {
+    if mode == MODE_MIP {
+        return vmax;
+    }
+    if mode == MODE_MIN_IP {
+        return vmin;
+    }
+    return vsum / f32(count);
+}
+
+// A projection region's value as one sample composited under acc (reference:
+// trace::close).
+fn emit_projection(r: Region, vmax: f32, vmin: f32, vsum: f32, count: u32, acc: vec4<f32>) -> vec4<f32> {
+    if !is_projection(r.mode) || count == 0u {
+        return acc;
+    }
+    let rgba = classify(r, projected(r.mode, vmax, vmin, vsum, count), scene.lut_atlas_width);
+    return composite(acc, rgba.rgb, rgba.a);
+}

@@ -1,0 +1,135 @@
+#define_import_path focal::segments
+
+// The ray's intervals and segments (reference: src/reference/trace.rs): per-interval
+// state bits, the sample grid of a one-region segment, the jumps over empty bricks, and
+// the cutting of intervals by a region's holes.
+
+#import focal::types::{Region, MAX_RAY_REGIONS}
+#import focal::bindings::{scene, regions}
+#import focal::lens::update_lod
+#import focal::sampling::{brick_occupied, brick_exit, at_full_resolution}
+
+// Per-interval state bits: the region is done with; it has a previous sample (iso);
+// it is DVR-like (two such share the DVR loop); it composites at its end (projections,
+// two-level).
+const DONE: u32 = 1u;
+const HAS_PREV: u32 = 2u;
+const PAIRABLE: u32 = 4u;
+const CLOSES: u32 = 8u;
+
+// The sample grid of a one-region segment: sample kk lies at t_start + (kk + j)·step on
+// the ray and at q_first + dq·(kk − k_first) in the region's voxels (qd: voxels per unit t).
+struct Segment {
+    q_first: vec3<f32>,
+    dq: vec3<f32>,
+    qd: vec3<f32>,
+    k_first: f32,
+    t_start: f32,
+    step: f32,
+    j: f32,
+}
+
+fn segment_t(g: Segment, kk: f32) -> f32 {
+    return g.t_start + (kk + g.j) * g.step;
+}
+
+// Voxel position of sample kk; under lenses also sets the mip level for it.
+fn segment_point(g: Segment, kk: f32) -> vec3<f32> {
+#ifdef HAS_LENSES
+    update_lod(segment_t(g, kk));
+#endif
+    return g.q_first + g.dq * (kk - g.k_first);
+}
+
+// Index of the first sample past the brick that holds sample kk (at q).
+fn past_brick(r: Region, g: Segment, q: vec3<f32>, kk: f32) -> f32 {
+    return max(kk + 1.0, ceil((brick_exit(r, q, g.qd, segment_t(g, kk)) - g.t_start) / g.step - g.j));
+}
+
+// The first sample from kk on (at most k_end + 1) that lies in an occupied brick or
+// below full resolution: empty bricks are crossed in a loop of their own, so the lanes
+// of a SIMD group that skip wait for each other there, then all take the next
+// (expensive) sample together. Occupancy holds for full-resolution samples only (a
+// coarser level blends in neighbouring bricks).
+fn past_empty_bricks(r: Region, g: Segment, kk_in: f32, k_end: f32) -> f32 {
+    var kk = kk_in;
+    for (var skip_steps = 0u; skip_steps < scene.max_steps; skip_steps++) {
+        if kk > k_end {
+            break;
+        }
+        let q = segment_point(g, kk);
+        if !at_full_resolution() || brick_occupied(r, q) {
+            break;
+        }
+        kk = past_brick(r, g, q, kk);
+    }
+    return kk;
+}
+
+// [`past_empty_bricks`] for two regions sampled together: the first sample from kk on
+// where either lies in an occupied brick (or below full resolution).
+fn past_empty_pair(ra: Region, ga: Segment, rb: Region, gb: Segment, kk_in: f32, k_end: f32) -> f32 {
+    var kk = kk_in;
+    for (var skip_steps = 0u; skip_steps < scene.max_steps; skip_steps++) {
+        if kk > k_end {
+            break;
+        }
+        let qa = segment_point(ga, kk);
+        let qb = gb.q_first + gb.dq * (kk - gb.k_first);
+        if !at_full_resolution() || brick_occupied(ra, qa) || brick_occupied(rb, qb) {
+            break;
+        }
+        kk = min(past_brick(ra, ga, qa, kk), past_brick(rb, gb, qb, kk));
+    }
+    return kk;
+}
+
+// Cuts the open interval `cut` out of intervals first..n of region i (reference:
+// region::subtract_interval) and returns the new count: an interval split in two adds
+// one at the end; one cut away whole is left empty (t0 > t1) for compact_intervals.
+fn cut_intervals(i: u32, first: u32, n: u32, cut: vec2<f32>, ids: ptr<function, array<u32, MAX_RAY_REGIONS>>, t0s: ptr<function, array<f32, MAX_RAY_REGIONS>>, t1s: ptr<function, array<f32, MAX_RAY_REGIONS>>) -> u32 {
+    var count = n;
+    for (var e = first; e < n; e++) {
+        let a = (*t0s)[e];
+        let b = (*t1s)[e];
+        if !(cut.x < b && cut.y > a && cut.x < cut.y) {
+            continue;
+        }
+        if cut.x > a {
+            (*t1s)[e] = cut.x;
+            if cut.y < b && count < MAX_RAY_REGIONS {
+                (*ids)[count] = i;
+                (*t0s)[count] = cut.y;
+                (*t1s)[count] = b;
+                count++;
+            }
+        } else if cut.y < b {
+            (*t0s)[e] = cut.y;
+        } else {
+            (*t0s)[e] = 1.0;
+            (*t1s)[e] = 0.0;
+        }
+    }
+    return count;
+}
+
+// Drops the empty intervals among first..n; returns the new count.
+fn compact_intervals(first: u32, n: u32, ids: ptr<function, array<u32, MAX_RAY_REGIONS>>, t0s: ptr<function, array<f32, MAX_RAY_REGIONS>>, t1s: ptr<function, array<f32, MAX_RAY_REGIONS>>) -> u32 {
+    var m = first;
+    for (var e = first; e < n; e++) {
+        if (*t0s)[e] < (*t1s)[e] {
+            (*ids)[m] = (*ids)[e];
+            (*t0s)[m] = (*t0s)[e];
+            (*t1s)[m] = (*t1s)[e];
+            m++;
+        }
+    }
+    return m;
+}
+
+// Whether the sample after the last one of a segment (index k_end) lies past t1: the
+// ray then leaves the region there, and what it gathered is emitted (the reference
+// closes a region at its first sample past t1).
+fn leaves(t_start: f32, k_end: f32, j: f32, step: f32, t1: f32) -> bool {
+    return t_start + (k_end + 1.0 + j) * step > t1;
+}
