@@ -179,10 +179,10 @@ mod tests {
         let r = selection_region(whole, &planes, dataset);
         let at = |q: Vec3| dataset.transform_point3(to_world.transform_point3(q));
         assert!(r.contains(at(Vec3::new(11.0, 4.0, 4.0))) && !r.contains(at(Vec3::new(20.0, 4.0, 4.0))));
-        // Only brick (1, 0, 0) holds selected voxels. Parts over brick x 0 only (index up
-        // to 7.5, its boundary) hold none of it; one reaching into brick x 1 (from index 7.5) does, and
-        // so does a small one whose corner lies in it; one over x 8..16 but in y brick 2
-        // does not.
+        // Only brick (1, 0, 0) holds selected voxels. A part over brick x 0 only (index
+        // up to 7.5, its boundary) holds none of it; one reaching past 7.5 into brick
+        // x 1 does, and so does a small one whose corner lies in it; one over x 8..16
+        // but in y brick 2 does not.
         let part = |lo: Vec3, hi: Vec3| Polyhedron::cuboid(to_world.transform_point3(lo), to_world.transform_point3(hi));
         assert!(!holds_selection(&part(Vec3::splat(-0.5), Vec3::new(7.5, 31.5, 31.5)), &sel), "a face on the boundary");
         assert!(holds_selection(&part(Vec3::splat(-0.5), Vec3::new(7.6, 31.5, 31.5)), &sel));

@@ -64,21 +64,8 @@ pub fn eighteen_exploded_parts_match_the_reference(gpu: &mut Gpu) {
     let selection = SelectionVolume::from_labels(&labels, &ids).unwrap();
     let world = gpu.off.world_mut();
     let data = world.spawn((Dataset::new(ct.clone(), skin), Transform::default(), Exploded::around(&selection))).id();
-    let (lo, hi) = ct.grid.world_bounds();
-    let cuts = |pieces: Vec<focal::explode::parts::Polyhedron>, axis: Vec3, n: usize| -> Vec<focal::explode::parts::Polyhedron> {
-        let (a, b) = (lo.dot(axis), hi.dot(axis));
-        (1..n).fold(pieces, |pieces, k| {
-            let offset = a + (b - a) * k as f32 / n as f32;
-            pieces
-                .into_iter()
-                .flat_map(|p| match p.split(Plane { normal: axis, offset }) {
-                    Some((x, y)) => vec![x, y],
-                    None => vec![p],
-                })
-                .collect()
-        })
-    };
-    let grid = cuts(cuts(cuts(vec![volume_polyhedron(&ct).unwrap()], Vec3::X, 3), Vec3::Y, 3), Vec3::Z, 2);
+    use focal::explode::spec::{ExplodeSpec, PartsSpec, SelectionSpec};
+    let grid = ExplodeSpec { parts: PartsSpec::Grid((3, 3, 2)), ..ExplodeSpec::around(SelectionSpec::Nothing) }.parts(&ct).unwrap();
     assert_eq!(grid.len(), 18);
     for rest in grid {
         spawn_part(world, Part::new(data, rest), Transform::default());

@@ -240,7 +240,6 @@ impl Bench {
     }
 }
 
-/// Rows of a group timed by [`Bench::interleaved`], against its first configuration.
 impl Row {
     /// The frame rate as a percentage of the baseline's (the paper's table 1 reports
     /// it so): 100 / ratio.
@@ -249,6 +248,7 @@ impl Row {
     }
 }
 
+/// Rows of a group timed by [`Bench::interleaved`], against its first configuration.
 fn push_group(rows: &mut Vec<Row>, group: &'static str, names: &[&str], ms: &[f64], base_note: &str, note: &str) {
     let base = names[0].to_string();
     for (i, (name, t)) in names.iter().zip(ms).enumerate() {
