@@ -337,7 +337,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [(&str, fn(&mut Gpu)); 23] = [
+    let tests: [(&str, fn(&mut Gpu)); 24] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -361,6 +361,7 @@ fn main() {
         ("a_magnifying_window_enlarges_its_source", windows::a_magnifying_window_enlarges_its_source),
         ("an_exploded_head_matches_the_reference", explode::an_exploded_head_matches_the_reference),
         ("eighteen_exploded_parts_match_the_reference", explode::eighteen_exploded_parts_match_the_reference),
+        ("a_selection_on_its_own_grid_matches_the_reference", explode::a_selection_on_its_own_grid_matches_the_reference),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

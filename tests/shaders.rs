@@ -51,7 +51,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 14] = [
+const DEFS: [&str; 15] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -66,13 +66,15 @@ const DEFS: [&str; 14] = [
     "LENS_ANTIALIAS",
     "HAS_SELECTION",
     "HAS_HOLES",
+    "DOI_CHANNEL",
 ];
 
 #[test]
 fn every_shader_variant_composes_and_validates() {
     let bit = |name: &str| 1u32 << DEFS.iter().position(|d| *d == name).unwrap();
     // Every combination the renderer can ask for: anti-aliasing only with lenses, DVR
-    // pairs and selection weights only with DVR.
+    // pairs and selection weights only with DVR, the degree of interest in the data's
+    // second channel only with weights.
     let needs = |a: &str, b: &str, bits: u32| bits & bit(a) == 0 || bits & bit(b) != 0;
     // Holes touch the interval code only: with the defs that share it, not every other.
     let interval_defs = bit("HAS_HOLES") | bit("HAS_DVR") | bit("MULTI_REGION") | bit("DVR_PAIRS") | bit("HAS_TWO_LEVEL");
@@ -80,6 +82,7 @@ fn every_shader_variant_composes_and_validates() {
         needs("LENS_ANTIALIAS", "HAS_LENSES", bits)
             && needs("DVR_PAIRS", "HAS_DVR", bits)
             && needs("HAS_SELECTION", "HAS_DVR", bits)
+            && needs("DOI_CHANNEL", "HAS_SELECTION", bits)
             && (bits & bit("HAS_HOLES") == 0 || bits & !interval_defs == 0)
     };
     for bits in (0u32..(1 << DEFS.len())).filter(|b| possible(*b)) {

@@ -9,7 +9,7 @@
 #import focal::bindings::{settings, scene}
 #import focal::camera::Ray
 #import focal::regions::to_voxel
-#import focal::sampling::{trilinear, nearest_code, index_gradient}
+#import focal::sampling::{trilinear, trilinear_with_doi, nearest_code, index_gradient}
 #import focal::transfer::{classify, classify_label, classify_lambda, correct_opacity}
 #import focal::shading::{shade, shade_with, blinn_phong}
 #import focal::context::{context_opacity, eye_distance}
@@ -31,31 +31,48 @@ fn shaded(r: Region, c: vec3<f32>, q: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
     return c;
 }
 
+// The value at q: fetched with the degree of interest (vd.x) or on its own.
+fn value_at(r: Region, q: vec3<f32>, vd: vec2<f32>) -> f32 {
+#ifdef DOI_CHANNEL
+    return vd.x;
+#else
+    return trilinear(r, q);
+#endif
+}
+
 // One DVR (label, gradient-modulated or context-preserving) sample at q, ray parameter
-// t, composited under acc. The gradient is fetched once for shading and modulation.
+// t, composited under acc, weighted by the current selection weight. The gradient is
+// fetched once for shading and modulation.
 fn dvr_sample(r: Region, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
     var rgba: vec4<f32>;
     var v = 0.0;
+    // The value and the selection's sample, in one fetch with DOI_CHANNEL (labels or not).
+    var vd = vec2(0.0);
+#ifdef DOI_CHANNEL
+    vd = trilinear_with_doi(r, q);
+#endif
 #ifdef HAS_LABELS
     if (r.flags & REGION_LABELS) != 0u {
         rgba = classify_label(r, nearest_code(r, q), scene.lut_atlas_width);
     } else {
-        v = trilinear(r, q);
+        v = value_at(r, q, vd);
         rgba = classify(r, v, scene.lut_atlas_width);
     }
 #else
-    v = trilinear(r, q);
+    v = value_at(r, q, vd);
     rgba = classify(r, v, scene.lut_atlas_width);
 #endif
-    return dvr_classified(r, q, v, rgba, ratio, ray, t, acc);
+    var w = 1.0;
+#ifdef HAS_SELECTION
+    w = weight_at(q, vd.y);
+#endif
+    return dvr_classified(r, q, v, rgba, w, ratio, ray, t, acc);
 }
 
-// dvr_sample after classification: value v (0 for labels) gave rgba.
-fn dvr_classified(r: Region, q: vec3<f32>, v: f32, rgba: vec4<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
-    var a = rgba.a;
-#ifdef HAS_SELECTION
-    a *= weight_at(q);
-#endif
+// dvr_sample after classification: value v (0 for labels) gave rgba, whose opacity
+// takes `weight`.
+fn dvr_classified(r: Region, q: vec3<f32>, v: f32, rgba: vec4<f32>, weight: f32, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
+    let a = rgba.a * weight;
     if a <= 0.0 {
         return acc;
     }

@@ -22,10 +22,16 @@ fn at_full_resolution() -> bool {
     return sample_lod <= 0.0;
 }
 
-// Trilinear sample of the atlas box at offset with dims, clamped to its edge voxels.
-fn trilinear_box(offset: vec3<f32>, dims: vec3<f32>, q: vec3<f32>) -> f32 {
+// Trilinear sample of the atlas box at offset with dims, clamped to its edge voxels:
+// every channel (the second holds a selection's degree of interest where
+// render::pack::doi_channels put it there).
+fn atlas_texel(offset: vec3<f32>, dims: vec3<f32>, q: vec3<f32>) -> vec4<f32> {
     let c = clamp(q, vec3(0.0), dims - 1.0);
-    return textureSampleLevel(volume_atlas, volume_sampler, (offset + c + 0.5) * scene.inv_atlas_size.xyz, 0.0).r;
+    return textureSampleLevel(volume_atlas, volume_sampler, (offset + c + 0.5) * scene.inv_atlas_size.xyz, 0.0);
+}
+
+fn trilinear_box(offset: vec3<f32>, dims: vec3<f32>, q: vec3<f32>) -> f32 {
+    return atlas_texel(offset, dims, q).r;
 }
 
 // Sample of mip level k (volume::pyramid: index (q + ½)/2^k − ½, size ⌈dims/2^k⌉; level
@@ -58,6 +64,18 @@ fn trilinear(r: Region, q: vec3<f32>) -> f32 {
     return mix(a, b, l - f32(k));
 #else
     return trilinear_box(r.atlas_offset.xyz, r.dims.xyz, q);
+#endif
+}
+
+// The sample at q (x, as trilinear) and the degree of interest its volume carries in
+// the second channel (y, the selection's normalised sample): one fetch; under lenses
+// with anti-aliasing the value may come from the mip levels, and the degree of
+// interest, which only the volume itself carries, from a fetch of its own.
+fn trilinear_with_doi(r: Region, q: vec3<f32>) -> vec2<f32> {
+#ifdef LENS_ANTIALIAS
+    return vec2(trilinear(r, q), atlas_texel(r.atlas_offset.xyz, r.dims.xyz, q).g);
+#else
+    return atlas_texel(r.atlas_offset.xyz, r.dims.xyz, q).rg;
 #endif
 }
 

@@ -71,14 +71,19 @@ fn pick_weight(a: Weight, b: Weight, second: bool) -> Weight {
     return w;
 }
 
-// The current weight at data voxel q. Where the selection's brick holds one code (none
-// selected, or all: most of a dataset) that gives the degree of interest without a
-// sample (GPUs that branch skip the fetch; llvmpipe runs both sides of a branch, so
-// there it saves nothing).
-fn weight_at(q: vec3<f32>) -> f32 {
+// The current weight at data voxel q. With DOI_CHANNEL the selection's normalised
+// sample is `carried`, fetched with the data (render::pack::doi_channels). Otherwise it
+// is sampled here; where the selection's brick holds one code (none selected, or all:
+// most of a dataset) that gives the degree of interest without a sample (GPUs that
+// branch skip the fetch; llvmpipe runs both sides of a branch, so there it saves
+// nothing).
+fn weight_at(q: vec3<f32>, carried: f32) -> f32 {
     if weight.keep == KEEP_NONE {
         return 1.0;
     }
+#ifdef DOI_CHANNEL
+    let t = carried;
+#else
     let qs = (weight.map * vec4(q, 1.0)).xyz;
     let size = f32(weight.bricks.w);
     let b = min(vec3<u32>(max(floor((qs + 0.5) / size), vec3(0.0))), weight.bricks.xyz - 1u);
@@ -88,6 +93,7 @@ fn weight_at(q: vec3<f32>) -> f32 {
     if kind == 2u {
         t = trilinear_box(weight.offset.xyz, weight.dims.xyz, qs);
     }
+#endif
     let doi = clamp(weight.ab.x * t + weight.ab.y, 0.0, 1.0);
     return select(doi, 1.0 - doi, weight.keep == KEEP_UNSELECTED);
 }

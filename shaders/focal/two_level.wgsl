@@ -124,7 +124,7 @@ fn two_level_sample(r: Region, labels: Region, part: ptr<function, Region>, open
     }
 #endif
 #ifdef HAS_DVR
-    out = dvr_classified(*part, q, v, classify(*part, v, scene.lut_atlas_width), ratio, ray, t, out);
+    out = dvr_classified(*part, q, v, classify(*part, v, scene.lut_atlas_width), 1.0, ratio, ray, t, out);
 #endif
     return out;
 }

@@ -68,9 +68,12 @@ pub mod features {
     /// Some region has holes (clip windows): the intervals are cut (llvmpipe ran that
     /// code for every region of every ray, holes or not).
     pub const HOLES: u32 = 8192;
+    /// Every selection weight's degree of interest lies in the second channel of its
+    /// data's texels (`render::pack::doi_channels`): one fetch gives value and weight.
+    pub const DOI_CHANNEL: u32 = 16384;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 14] = [
+    pub const NAMES: [(u32, &str); 15] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -85,6 +88,7 @@ pub mod features {
         (LENS_ANTIALIAS, "LENS_ANTIALIAS"),
         (SELECTION, "HAS_SELECTION"),
         (HOLES, "HAS_HOLES"),
+        (DOI_CHANNEL, "DOI_CHANNEL"),
     ];
 }
 

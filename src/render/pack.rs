@@ -6,6 +6,9 @@
 //! on software Vulkan), and a `switch` over texture slots in the inner loop multiplies
 //! the sampling code.
 //!
+//! A selection weight's degree of interest, when its selection lies on its data's grid,
+//! rides in a second channel of the data's texels ([`doi_channels`]).
+//!
 //! Packing reuses the CPU reference's preparation ([`crate::reference::prepare`]), so
 //! both renderers classify, step and shade with the same numbers. It decides nothing.
 
@@ -44,6 +47,9 @@ pub struct PackedScene {
     pub brick_atlas: Atlas,
     /// Regions left out, with the reason (the atlas is full).
     pub dropped: Vec<String>,
+    /// Per entry of `volumes`: the scene volume whose codes fill the second channel of
+    /// its texels (a selection's degree of interest, [`doi_channels`]).
+    pub doi_channels: Vec<Option<usize>>,
     /// Index in `regions` of every scene region (`None` for those dropped).
     pub region_slots: Vec<Option<u32>>,
     /// Regions the ray traverses: the first `region_count` of `regions` (the others
@@ -127,6 +133,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
     let prepared = crate::reference::prepare(scene)?;
     let all = scene.all_volumes();
     let index_of = |v: &std::sync::Arc<crate::volume::Volume>| all.iter().position(|a| std::sync::Arc::ptr_eq(a, v));
+    let channels = doi_channels(&prepared, &all);
     // The volumes each region samples: its own, and a segmentation's label volume.
     let uses: Vec<Vec<usize>> = prepared
         .iter()
@@ -136,7 +143,8 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
             if let Some(seg) = appearance.and_then(|a| a.segmentation.as_ref()) {
                 u.extend(index_of(&seg.labels));
             }
-            if let Some(w) = appearance.and_then(|a| a.selection.as_ref()) {
+            // (A selection in its data's second channel needs no room of its own.)
+            if let Some(w) = appearance.and_then(|a| a.selection.as_ref()).filter(|_| channels.is_none()) {
                 u.extend(index_of(&w.volume));
             }
             u
@@ -177,6 +185,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.levels.push(out.atlas.offsets[next..next + count].to_vec());
         next += count;
     }
+    out.doi_channels = out.volumes.iter().map(|&v| channels.as_ref().and_then(|c| c[v])).collect();
     let slot_of = |out: &PackedScene, v: usize| out.volumes.iter().position(|&u| u == v);
     let mut segmented = Vec::new();
     let mut weighted = Vec::new();
@@ -214,6 +223,9 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.regions[index].objects.w = pack_selection(p, slot, &mut out);
     }
     out.features = scene_features(&out.regions, overlaps(&prepared));
+    if channels.is_some() && out.features & super::gpu_types::features::SELECTION != 0 {
+        out.features |= super::gpu_types::features::DOI_CHANNEL;
+    }
     out.max_steps = march_bound(&out.regions[..out.region_count as usize], union_extent(&prepared));
     // Empty scenes still bind (1-texel) atlases.
     out.atlas.size = out.atlas.size.max(UVec3::ONE);
@@ -230,6 +242,31 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.planes.push(Vec4::ZERO);
     }
     Ok(out)
+}
+
+/// Per scene volume (`all`), the selection volume whose degree of interest can ride in
+/// the second channel of its texels, so that one texture fetch gives a sample's value
+/// and its weight (on llvmpipe the weight's own fetch and lookups cost a tenth of an
+/// exploded view's frame at rest, and its selection needs no atlas room of its own).
+/// `None` unless some region is weighted and every weighted region's selection lies on
+/// its data's voxel grid (the same dimensions, the identity between their voxel
+/// indices: the trilinear filter then weighs both channels alike, so the weight is the
+/// reference's) and no volume has two selections.
+pub fn doi_channels(prepared: &[PreparedRegion], all: &[std::sync::Arc<crate::volume::Volume>]) -> Option<Vec<Option<usize>>> {
+    let mut channels = vec![None; all.len()];
+    let mut any = false;
+    for p in prepared {
+        let Some(w) = &p.weight else { continue };
+        let data = all.iter().position(|a| std::ptr::eq(a.as_ref(), p.volume))?;
+        let selection = all.iter().position(|a| std::sync::Arc::ptr_eq(a, &w.weight.volume))?;
+        let on_grid = w.weight.volume.dims() == p.volume.dims() && w.data_to_selection.abs_diff_eq(glam::Affine3A::IDENTITY, 1e-5);
+        if !on_grid || channels[data].is_some_and(|s| s != selection) {
+            return None;
+        }
+        channels[data] = Some(selection);
+        any = true;
+    }
+    any.then_some(channels)
 }
 
 /// Appends the part records of a segmented region (each object, then the rest: the

@@ -90,10 +90,16 @@ pub fn upload_scene(
         );
     }
     let all = scene.all_volumes();
-    let key: Vec<usize> = packed.volumes.iter().map(|&v| Arc::as_ptr(&all[v]) as usize).collect();
+    let seconds = packed.doi_channels.iter().map(|c| c.map(|v| all[v].as_ref()));
+    let key: Vec<usize> = packed
+        .volumes
+        .iter()
+        .map(|&v| Arc::as_ptr(&all[v]) as usize)
+        .chain(seconds.clone().map(|s| s.map_or(0, |s| s as *const Volume as usize)))
+        .collect();
     if gpu.atlas_key != key || gpu.atlases.is_none() {
-        let volumes: Vec<&Volume> = packed.volumes.iter().map(|&v| all[v].as_ref()).collect();
-        gpu.atlases = Some(atlases(&device, &queue, &volumes, &packed, sixteen_bit_format(&adapter)));
+        let volumes: Vec<(&Volume, Option<&Volume>)> = packed.volumes.iter().map(|&v| all[v].as_ref()).zip(seconds).collect();
+        gpu.atlases = Some(atlases(&device, &queue, &volumes, &packed, sixteen_bit_formats(&adapter)));
         gpu.atlas_key = key;
     }
     write_buffers(&device, &queue, &packed, &mut gpu);
@@ -104,14 +110,17 @@ pub fn upload_scene(
     gpu.last = Some(scene.clone());
 }
 
-/// `R16Unorm` where the device has filterable 16-bit normalised textures, else `R16Float`.
-fn sixteen_bit_format(adapter: &RenderAdapter) -> TextureFormat {
-    let f = adapter.get_texture_format_features(TextureFormat::R16Unorm);
-    if f.allowed_usages.contains(TextureUsages::TEXTURE_BINDING) && f.flags.contains(TextureFormatFeatureFlags::FILTERABLE) {
-        TextureFormat::R16Unorm
-    } else {
-        TextureFormat::R16Float
-    }
+/// The 16-bit formats of one and two channels: normalised where the device filters
+/// them, else half floats.
+fn sixteen_bit_formats(adapter: &RenderAdapter) -> [TextureFormat; 2] {
+    let filterable = |format: TextureFormat| {
+        let f = adapter.get_texture_format_features(format);
+        f.allowed_usages.contains(TextureUsages::TEXTURE_BINDING) && f.flags.contains(TextureFormatFeatureFlags::FILTERABLE)
+    };
+    [
+        if filterable(TextureFormat::R16Unorm) { TextureFormat::R16Unorm } else { TextureFormat::R16Float },
+        if filterable(TextureFormat::Rg16Unorm) { TextureFormat::Rg16Unorm } else { TextureFormat::Rg16Float },
+    ]
 }
 
 fn texture_3d(
@@ -161,42 +170,61 @@ fn volume_levels(v: &Volume, mips: bool) -> impl Iterator<Item = (&Voxels, UVec3
 }
 
 /// The volume atlas (8-bit when every volume is, else 16-bit: 8-bit codes `c` become
-/// `257·c`, the same normalised value; `R16Float` halves `code / 65535` where
-/// `R16Unorm` is missing) and the brick min-max atlas (`Rg16Uint`, codes as stored).
-fn atlases(device: &RenderDevice, queue: &RenderQueue, volumes: &[&Volume], packed: &PackedScene, format16: TextureFormat) -> GpuAtlases {
+/// `257·c`, the same normalised value; half floats of `code / 65535` where 16-bit
+/// normalised textures are missing) and the brick min-max atlas (`Rg16Uint`, codes as
+/// stored). Each volume may carry a second volume of its dimensions in a second channel
+/// (the degree of interest of its selection, `pack::doi_channels`; its mip levels carry
+/// 0 there): the atlas then has two channels.
+fn atlases(
+    device: &RenderDevice,
+    queue: &RenderQueue,
+    volumes: &[(&Volume, Option<&Volume>)],
+    packed: &PackedScene,
+    formats16: [TextureFormat; 2],
+) -> GpuAtlases {
     let size = packed.atlas.size;
     let texels = (size.x * size.y * size.z) as usize;
-    let sixteen = volumes.iter().any(|v| v.voxels.bits() == 16);
-    let (format, data) = if !sixteen {
-        let mut data = vec![0u8; texels];
-        for (slot, v) in volumes.iter().enumerate() {
-            for ((voxels, dims), &o) in volume_levels(v, packed.mips).zip(&packed.levels[slot]) {
-                blit(&mut data, size, voxels.as_bytes(), dims, o, 1);
-            }
-        }
-        (TextureFormat::R8Unorm, data)
-    } else {
-        let mut data = vec![0u8; texels * 2];
-        for (slot, v) in volumes.iter().enumerate() {
-            let scale = if v.voxels.bits() == 8 { 257 } else { 1 };
-            let encode = |c: u16| -> [u8; 2] {
-                let c = c as u32 * scale;
-                match format16 {
-                    TextureFormat::R16Unorm => (c as u16).to_le_bytes(),
-                    _ => half::f16::from_f32(c as f32 / 65535.0).to_le_bytes(),
-                }
-            };
-            for ((voxels, dims), &o) in volume_levels(v, packed.mips).zip(&packed.levels[slot]) {
-                let bytes: Vec<u8> = (0..voxels.len()).flat_map(|i| encode(voxels.code(i))).collect();
-                blit(&mut data, size, &bytes, dims, o, 2);
-            }
-        }
-        (format16, data)
+    let channels = if volumes.iter().any(|(_, s)| s.is_some()) { 2 } else { 1 };
+    let all = volumes.iter().flat_map(|(v, s)| std::iter::once(*v).chain(*s));
+    let sixteen = all.clone().any(|v| v.voxels.bits() == 16);
+    let (format, bytes) = match (sixteen, channels) {
+        (false, 1) => (TextureFormat::R8Unorm, 1),
+        (false, _) => (TextureFormat::Rg8Unorm, 2),
+        (true, c) => (formats16[c - 1], 2 * c),
     };
+    let push = |out: &mut Vec<u8>, c: u16, bits: u32| {
+        if !sixteen {
+            out.push(c as u8);
+            return;
+        }
+        let c = c as u32 * if bits == 8 { 257 } else { 1 };
+        match format {
+            TextureFormat::R16Unorm | TextureFormat::Rg16Unorm => out.extend((c as u16).to_le_bytes()),
+            _ => out.extend(half::f16::from_f32(c as f32 / 65535.0).to_le_bytes()),
+        }
+    };
+    let mut data = vec![0u8; texels * bytes];
+    for (slot, (v, second)) in volumes.iter().enumerate() {
+        for (level, ((voxels, dims), &o)) in volume_levels(v, packed.mips).zip(&packed.levels[slot]).enumerate() {
+            if bytes == 1 {
+                blit(&mut data, size, voxels.as_bytes(), dims, o, 1);
+                continue;
+            }
+            let second = second.filter(|s| level == 0 && s.voxels.len() == voxels.len());
+            let mut texels = Vec::with_capacity(voxels.len() * bytes);
+            for i in 0..voxels.len() {
+                push(&mut texels, voxels.code(i), v.voxels.bits());
+                if channels == 2 {
+                    push(&mut texels, second.map_or(0, |s| s.voxels.code(i)), second.map_or(8, |s| s.voxels.bits()));
+                }
+            }
+            blit(&mut data, size, &texels, dims, o, bytes);
+        }
+    }
     let (vt, vv) = texture_3d(device, queue, "focal volume atlas", size, format, &data);
     let bsize = packed.brick_atlas.size;
     let mut bricks = vec![0u8; (bsize.x * bsize.y * bsize.z) as usize * 4];
-    for (v, &o) in volumes.iter().zip(&packed.brick_atlas.offsets) {
+    for ((v, _), &o) in volumes.iter().zip(&packed.brick_atlas.offsets) {
         let g = v.bricks();
         let pairs: Vec<u8> = g.min.iter().zip(&g.max).flat_map(|(&lo, &hi)| [lo.to_le_bytes(), hi.to_le_bytes()].concat()).collect();
         blit(&mut bricks, bsize, &pairs, g.dims, o, 4);

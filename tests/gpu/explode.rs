@@ -9,7 +9,22 @@ use focal::explode::{Exploded, Part, step};
 use focal::region::Plane;
 use focal::volume::SelectionVolume;
 
+/// The selection on the data's grid: its degree of interest rides in the second channel
+/// of the data's texels (`render::pack::doi_channels`).
 pub fn an_exploded_head_matches_the_reference(gpu: &mut Gpu) {
+    exploded_halves(gpu, true);
+}
+
+/// The selection on a grid of its own (the data's shifted by half a voxel): the weights
+/// sample it in its own box of the atlas.
+pub fn a_selection_on_its_own_grid_matches_the_reference(gpu: &mut Gpu) {
+    exploded_halves(gpu, false);
+}
+
+/// The head in two halves, at rest and pushed apart, against the reference; `carried`:
+/// the selection on the data's grid, so that the packed scene carries its degree of
+/// interest with the data (else on a grid shifted by half a voxel).
+fn exploded_halves(gpu: &mut Gpu, carried: bool) {
     let ct = head();
     let skin = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap());
     gpu.clear();
@@ -18,7 +33,13 @@ pub fn an_exploded_head_matches_the_reference(gpu: &mut Gpu) {
     let labels = phantom::head::generate(64).unwrap().labels;
     use phantom::head::label::{ARTERIES, CALCIFICATIONS};
     let ids = [ARTERIES as u32, CALCIFICATIONS as u32].into_iter().collect();
-    let selection = SelectionVolume::from_labels(&labels, &ids).unwrap();
+    let mut selection = SelectionVolume::from_labels(&labels, &ids).unwrap();
+    if !carried {
+        let mut grid = selection.volume.grid.clone();
+        grid.origin += grid.spacing * 0.5;
+        let codes = (0..selection.volume.voxels.len()).map(|i| selection.volume.voxels.code(i) as u8).collect();
+        selection = SelectionVolume::from_codes(grid, codes).unwrap();
+    }
     let exploded = Exploded {
         selection_look: Some(Appearance::new(Mode::Dvr, presets::builtin("ct_vessels").unwrap())),
         ..Exploded::around(&selection)
@@ -38,11 +59,14 @@ pub fn an_exploded_head_matches_the_reference(gpu: &mut Gpu) {
         let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
         render(&scene, &cam, SIZE, SIZE).unwrap().to_image().unwrap()
     };
-    assert_matches("exploded_at_rest", &at_rest, &cpu(gpu));
+    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
+    let features = focal::render::pack::pack(&scene, 2048).unwrap().features;
+    assert_eq!(features & focal::render::gpu_types::features::DOI_CHANNEL != 0, carried);
+    assert_matches(&format!("exploded_at_rest_{carried}"), &at_rest, &cpu(gpu));
     gpu.off.world_mut().get_mut::<Exploded>(data).unwrap().coefficients.degree = 1.0;
     step(gpu.off.world_mut(), 400);
     let apart = gpu.off.capture().unwrap();
-    assert_matches("exploded_apart", &apart, &cpu(gpu));
+    assert_matches(&format!("exploded_apart_{carried}"), &apart, &cpu(gpu));
     // The halves moved off the middle: the middle column now shows the selection (the
     // arteries, red in the vessels' colours) or the background, not the skin it showed.
     let changed = (20..44).filter(|&y| apart.get_pixel(32, y).0[..3] != at_rest.get_pixel(32, y).0[..3]).count();

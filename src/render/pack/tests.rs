@@ -247,3 +247,48 @@ fn volumes_beyond_the_atlas_are_reported() {
     // DVR regions carry their occupancy bits.
     assert!(packed.regions.iter().all(|r| r.flags & region_flags::OCCUPANCY != 0));
 }
+
+#[test]
+fn a_selection_on_its_datas_grid_rides_in_the_second_channel() {
+    use super::super::gpu_types::features;
+    use crate::region::{Keep, SelectionWeight};
+    use crate::volume::{Grid, SelectionVolume};
+    let v = Arc::new(phantom::sphere(16, 5.0).unwrap());
+    let selected = |grid: Grid| {
+        let n = grid.dims.element_product() as usize;
+        Arc::new(SelectionVolume::from_codes(grid, (0..n).map(|i| if i % 7 == 0 { 255 } else { 0 }).collect()).unwrap().volume)
+    };
+    // The data less the selection, and the selection drawn over it (an exploded view at
+    // rest).
+    let scene_with = |a: &Arc<crate::volume::Volume>, b: &Arc<crate::volume::Volume>| {
+        let look = |s: &Arc<crate::volume::Volume>, keep| Appearance {
+            selection: Some(SelectionWeight { volume: s.clone(), keep }),
+            ..Appearance::new(Mode::Dvr, presets::builtin("grayscale_ramp").unwrap())
+        };
+        let mut scene = RenderScene::single(v.clone(), look(a, Keep::Unselected));
+        scene.appearances.push(look(b, Keep::Selected));
+        scene.regions.push(Region { appearance: 1, ..scene.regions[0].clone() });
+        scene
+    };
+    // On the data's grid: one atlas volume, the data, carrying the selection (scene
+    // volume 1) in its second channel; the regions are still weighted (their selection
+    // records give the degree of interest's scale and which side they keep).
+    let on_grid = selected(v.grid.clone());
+    let packed = pack(&scene_with(&on_grid, &on_grid), 2048).unwrap();
+    assert_ne!(packed.features & features::DOI_CHANNEL, 0);
+    assert_eq!((packed.volumes.clone(), packed.doi_channels.clone()), (vec![0], vec![Some(1)]));
+    assert_eq!(packed.regions[0].flags & region_flags::SELECTION, region_flags::SELECTION);
+    assert_eq!(packed.regions[1].flags & region_flags::KEEP_UNSELECTED, 0);
+    // On a grid of its own (twice as coarse): the weights sample it in its own box.
+    let coarse = selected(Grid::new(glam::UVec3::splat(8), v.grid.spacing * 2.0));
+    let packed = pack(&scene_with(&coarse, &coarse), 2048).unwrap();
+    assert_eq!(packed.features & features::DOI_CHANNEL, 0);
+    assert_eq!((packed.volumes.clone(), packed.doi_channels.clone()), (vec![0, 1], vec![None, None]));
+    // Two selections of one volume: one channel cannot hold both.
+    let other = selected(v.grid.clone());
+    let packed = pack(&scene_with(&on_grid, &other), 2048).unwrap();
+    assert_eq!((packed.features & features::DOI_CHANNEL, packed.volumes.len()), (0, 3));
+    // No weights, no channel.
+    let plain = RenderScene::single(v.clone(), Appearance::new(Mode::Dvr, presets::builtin("grayscale_ramp").unwrap()));
+    assert_eq!(pack(&plain, 2048).unwrap().doi_channels, vec![None]);
+}
