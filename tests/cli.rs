@@ -74,4 +74,9 @@ fn bench_explode_reports_table_1_as_percentages_of_the_plain_frame_rate() {
         assert!(ratio > 0.0 && (percent * ratio - 100.0).abs() < 1e-6, "{r}");
     }
     assert_eq!(rows[0]["frame_rate_percent"], 100.0);
+    // Each picture's samples against the plain one's (CPU reference): the parts pushed
+    // apart show their insides, so more of them.
+    let samples: Vec<f64> = rows.iter().map(|r| r["sample_ratio"].as_f64().unwrap()).collect();
+    assert_eq!(samples[0], 1.0);
+    assert!(samples[4] > samples[3] && samples[3] >= 1.0, "{samples:?}");
 }

@@ -226,6 +226,31 @@ fn empty_space_skipping_does_not_change_the_image() {
 }
 
 #[test]
+fn the_samples_a_picture_takes_are_counted_per_region() {
+    // The skull: without skipping every sample position is a sample of the region; with
+    // it the empty bricks' are not, and the march itself is the same.
+    let h = Arc::new(Phantom::Head.generate(64).unwrap());
+    let mut scene = RenderScene::single(h.clone(), Appearance::new(Mode::Dvr, presets::builtin("ct_bone").unwrap()));
+    let cam = View::Oblique.frame(h.grid.center(), 130.0, false);
+    let skipped = render(&scene, &cam, 32, 32).unwrap();
+    scene.skip_empty = false;
+    let full = render(&scene, &cam, 32, 32).unwrap();
+    assert_eq!(full.classified, full.samples);
+    assert_eq!(skipped.samples, full.samples);
+    assert!(skipped.classified > 0 && skipped.classified < full.classified * 3 / 4, "{} of {}", skipped.classified, full.classified);
+    // Two copies of a nearly transparent region (no ray ends early): each position is
+    // a sample of both.
+    let mut faint = opaque_ramp();
+    faint.opacity = vec![OpacityPoint(0.0, 0.001), OpacityPoint(1.0, 0.001)];
+    let mut one = RenderScene::single(h.clone(), Appearance::new(Mode::Dvr, faint));
+    one.skip_empty = false;
+    let mut two = one.clone();
+    two.regions.push(Region::volume_box(&h.grid, 0, 0));
+    let (a, b) = (render(&one, &cam, 32, 32).unwrap(), render(&two, &cam, 32, 32).unwrap());
+    assert_eq!((b.samples, b.classified), (a.samples, 2 * a.classified));
+}
+
+#[test]
 fn opacity_correction_keeps_the_image_across_step_sizes() {
     let h = Phantom::Head.generate(64).unwrap();
     let tf = presets::builtin("ct_skin_bone").unwrap();

@@ -24,6 +24,8 @@ pub struct RenderedImage {
     pub depth: Vec<f32>,
     /// Sample positions visited over the whole image.
     pub samples: u64,
+    /// Samples the regions took over the whole image ([`Traced::classified`]).
+    pub classified: u64,
 }
 
 impl RenderedImage {
@@ -36,6 +38,7 @@ impl RenderedImage {
             value: pixels.iter().map(|p| p.value).collect(),
             depth: pixels.iter().map(|p| p.depth).collect(),
             samples: pixels.iter().map(|p| p.samples as u64).sum(),
+            classified: pixels.iter().map(|p| p.classified as u64).sum(),
         }
     }
 

@@ -94,6 +94,9 @@ struct Row {
     ms: f64,
     baseline: String,
     ratio: f64,
+    /// The picture's samples against the baseline's, where counted
+    /// ([`Bench::classified_samples`]).
+    sample_ratio: Option<f64>,
     note: String,
 }
 
@@ -101,6 +104,8 @@ struct Bench {
     off: Offscreen,
     frames: u32,
     save: Option<std::path::PathBuf>,
+    /// The camera of the last [`Self::place`].
+    camera: Option<focal::region::Camera>,
 }
 
 impl Bench {
@@ -124,6 +129,7 @@ impl Bench {
         self.off.world_mut().spawn((Dataset::new(volume, appearance), Transform::default()));
         let camera = View::Oblique.frame_box(lo, hi, self.off.width as f32 / self.off.height as f32, false);
         self.off.set_camera(&camera);
+        self.camera = Some(camera);
         (camera, (lo + hi) * 0.5)
     }
 }
@@ -222,6 +228,27 @@ impl Bench {
     }
 }
 
+impl Bench {
+    /// The samples the regions take in each of `count` configurations (`set` switches to
+    /// one, as for [`Self::interleaved_by`]), counted by the CPU reference
+    /// ([`focal::reference::RenderedImage::classified`]) at 128 pixels across with the
+    /// bench's camera: what each picture costs a ray caster that skips empty space,
+    /// whatever its hardware.
+    fn classified_samples(&mut self, count: usize, mut set: impl FnMut(&mut Offscreen, usize)) -> Result<Vec<u64>, String> {
+        let camera = self.camera.ok_or("no view placed to count samples in")?;
+        let across = 128.0 / self.off.width.max(self.off.height) as f32;
+        let (w, h) = ((self.off.width as f32 * across).round().max(1.0) as u32, (self.off.height as f32 * across).round().max(1.0) as u32);
+        (0..count)
+            .map(|i| {
+                set(&mut self.off, i);
+                self.off.update();
+                let scene = self.off.world_mut().resource::<focal::dataset::SceneRegions>().scene.clone();
+                Ok(focal::reference::render(&scene, &camera, w, h)?.classified)
+            })
+            .collect()
+    }
+}
+
 /// Names of configurations.
 fn names(configs: &[Config]) -> Vec<&'static str> {
     configs.iter().map(|c| c.0).collect()
@@ -253,7 +280,7 @@ fn push_group(rows: &mut Vec<Row>, group: &'static str, names: &[&str], ms: &[f6
     let base = names[0].to_string();
     for (i, (name, t)) in names.iter().zip(ms).enumerate() {
         let note = if i == 0 { base_note } else { note };
-        rows.push(Row { group, config: name.to_string(), ms: *t, baseline: base.clone(), ratio: t / ms[0].max(1e-9), note: note.into() });
+        rows.push(Row { group, config: name.to_string(), ms: *t, baseline: base.clone(), ratio: t / ms[0].max(1e-9), sample_ratio: None, note: note.into() });
     }
 }
 
@@ -274,7 +301,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         app.add_plugins(FocalPlugins);
     })?;
     eprintln!("GPU: {}  image {w}×{h}, {} frames per configuration", off.adapter_name(), args.frames);
-    let mut bench = Bench { off, frames: args.frames.max(1), save: args.save.clone() };
+    let mut bench = Bench { off, frames: args.frames.max(1), save: args.save.clone(), camera: None };
     let still = VolumeView { jitter: false, ..Default::default() };
     let mut rows = Vec::new();
 
@@ -318,6 +345,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
                 ms,
                 baseline: "dvr".into(),
                 ratio: ms / dvr.max(1e-9),
+                sample_ratio: None,
                 note: "engine phantom".into(),
             });
         }
@@ -446,14 +474,15 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let v: Vec<_> =
             rows
             .iter()
-            .map(|r| json!({"group": r.group, "config": r.config, "ms_per_frame": r.ms, "baseline": r.baseline, "ratio": r.ratio, "frame_rate_percent": r.frame_rate_percent(), "note": r.note}))
+            .map(|r| json!({"group": r.group, "config": r.config, "ms_per_frame": r.ms, "baseline": r.baseline, "ratio": r.ratio, "frame_rate_percent": r.frame_rate_percent(), "sample_ratio": r.sample_ratio, "note": r.note}))
             .collect();
         println!("{}", serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?);
     } else {
         for r in &rows {
+            let samples = r.sample_ratio.map_or(String::new(), |s| format!(", its picture ×{s:.2} the samples"));
             let note = if r.note.is_empty() { String::new() } else { format!("  ({})", r.note) };
             println!(
-                "{:<12} {:<16} {:>9.1} ms/frame  ×{:.2} vs {} ({:.0} % of its frame rate){note}",
+                "{:<12} {:<16} {:>9.1} ms/frame  ×{:.2} vs {} ({:.0} % of its frame rate{samples}){note}",
                 r.group,
                 r.config,
                 r.ms,
