@@ -37,7 +37,7 @@
 #import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod}
 #import focal::regions::{region_interval, hole_interval, meets_sphere, pick_region, to_voxel, dir_to_voxel, world_step}
 #import focal::sampling::{trilinear, brick_occupied, brick_range, at_full_resolution}
-#import focal::selection::{Weight, region_weight, set_weight, pick_weight}
+#import focal::selection::{Weight, region_weight, set_weight, pick_weight, set_companion, no_companion}
 #import focal::samples::{is_projection, dvr_sample, is_dvr_like, iso_hit, emit_projection}
 #import focal::segments::{DONE, HAS_PREV, PAIRABLE, CLOSES, Segment, segment_t, segment_point, past_brick, past_empty_bricks, past_empty_pair, cut_intervals, compact_intervals, leaves}
 #ifdef HAS_TWO_LEVEL
@@ -362,6 +362,10 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                     let weight_a = region_weight(r);
                     let weight_b = region_weight(rb);
 #endif
+#ifdef COMPANION
+                    // (A region's companion adds nothing where a third region is.)
+                    no_companion();
+#endif
                     let occupancy_a = skip && (r.flags & REGION_OCCUPANCY) != 0u;
                     let occupancy_b = skip && (rb.flags & REGION_OCCUPANCY) != 0u;
                     var second = false;
@@ -407,6 +411,9 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #ifdef HAS_SELECTION
                     set_weight(region_weight(r));
 #endif
+#ifdef COMPANION
+                    set_companion(r, ray.dir, step);
+#endif
                     for (var dvr_steps = 0u; dvr_steps < scene.max_steps; dvr_steps++) {
                         if kk > k_end || acc.a >= stop {
                             break;
@@ -434,6 +441,9 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
         let p = ray.origin + ray.dir * t;
 #ifdef HAS_LENSES
         update_lod(t);
+#endif
+#ifdef COMPANION
+        no_companion();
 #endif
         for (var s = 0u; s < n; s++) {
             if (state[s] & DONE) != 0u || t < t0s[s] || t > t1s[s] {

@@ -259,9 +259,12 @@ fn parts_at_rest_draw_as_one_region_and_the_selection_only_where_it_can_draw() {
     assert!(sel.iter().all(|v| (*v - centre).abs().max_element() < 40.0 + 2.0 * 30.0), "{sel:?}");
     assert!(sel.iter().any(|v| (*v - centre).abs().max_element() >= 40.0));
     // The two overlap: the ray caster is told to composite both there (a sample inside
-    // both must not be the selection's alone).
+    // both must not be the selection's alone), the selection drawn in the parts'
+    // samples (render::pack::companions) or the two paired.
     let prepared = focal::reference::prepare(&scene).unwrap();
-    assert!(focal::render::pack::overlaps(&prepared).dvr_pairs);
+    assert!(focal::render::pack::overlaps(&prepared.iter().collect::<Vec<_>>()).dvr_pairs);
+    use focal::render::gpu_types::features::{COMPANION, DVR_PAIRS};
+    assert_ne!(focal::render::pack::pack(&scene, 2048).unwrap().features & (COMPANION | DVR_PAIRS), 0);
     // Exploded: a region per part; the parts that do not meet the selection's box
     // draw without its weight, those that do with it.
     set_degree(&mut app, dataset, 1.0);

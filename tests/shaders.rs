@@ -51,7 +51,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 15] = [
+const DEFS: [&str; 16] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -67,6 +67,7 @@ const DEFS: [&str; 15] = [
     "HAS_SELECTION",
     "HAS_HOLES",
     "DOI_CHANNEL",
+    "COMPANION",
 ];
 
 #[test]
@@ -74,7 +75,7 @@ fn every_shader_variant_composes_and_validates() {
     let bit = |name: &str| 1u32 << DEFS.iter().position(|d| *d == name).unwrap();
     // Every combination the renderer can ask for: anti-aliasing only with lenses, DVR
     // pairs and selection weights only with DVR, the degree of interest in the data's
-    // second channel only with weights.
+    // second channel only with weights, companions only with it.
     let needs = |a: &str, b: &str, bits: u32| bits & bit(a) == 0 || bits & bit(b) != 0;
     // Holes touch the interval code only: with the defs that share it, not every other.
     let interval_defs = bit("HAS_HOLES") | bit("HAS_DVR") | bit("MULTI_REGION") | bit("DVR_PAIRS") | bit("HAS_TWO_LEVEL");
@@ -83,6 +84,7 @@ fn every_shader_variant_composes_and_validates() {
             && needs("DVR_PAIRS", "HAS_DVR", bits)
             && needs("HAS_SELECTION", "HAS_DVR", bits)
             && needs("DOI_CHANNEL", "HAS_SELECTION", bits)
+            && needs("COMPANION", "DOI_CHANNEL", bits)
             && (bits & bit("HAS_HOLES") == 0 || bits & !interval_defs == 0)
     };
     for bits in (0u32..(1 << DEFS.len())).filter(|b| possible(*b)) {

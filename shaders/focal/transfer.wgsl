@@ -7,13 +7,19 @@
 #import focal::types::Region
 #import focal::sampling::lut_texel
 
-// The table of lut_width texels at `base`, linearly filtered at the sample t.
-fn filtered(r: Region, base: u32, t: f32, atlas_width: u32) -> vec4<f32> {
-    let n = f32(r.lut_width);
-    let x = clamp((r.lut_a * t + r.lut_b) * n - 0.5, 0.0, n - 1.0);
-    let i = min(u32(x), r.lut_width - 2u);
+// The table of `width` texels at `base`, linearly filtered at the sample t, which
+// a·t + b maps onto it.
+fn filtered_table(base: u32, width: u32, a: f32, b: f32, t: f32, atlas_width: u32) -> vec4<f32> {
+    let n = f32(width);
+    let x = clamp((a * t + b) * n - 0.5, 0.0, n - 1.0);
+    let i = min(u32(x), width - 2u);
     let f = x - f32(i);
     return mix(lut_texel(base + i, atlas_width), lut_texel(base + i + 1u, atlas_width), f);
+}
+
+// Region r's table of lut_width texels at `base`, filtered at t.
+fn filtered(r: Region, base: u32, t: f32, atlas_width: u32) -> vec4<f32> {
+    return filtered_table(base, r.lut_width, r.lut_a, r.lut_b, t, atlas_width);
 }
 
 fn classify(r: Region, t: f32, atlas_width: u32) -> vec4<f32> {

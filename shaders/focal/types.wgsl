@@ -97,6 +97,8 @@ const REGION_LAMBDA: u32 = 8u;
 // Opacity weighted by a selection (record: objects.w); KEEP_UNSELECTED: by 1 − doi.
 const REGION_SELECTION: u32 = 16u;
 const REGION_KEEP_UNSELECTED: u32 = 32u;
+// Another region is drawn in this one's samples (record: objects.z; render::pack::companions).
+const REGION_COMPANION: u32 = 64u;
 
 const VIEW_JITTER: u32 = 1u;
 const VIEW_SKIP_EMPTY: u32 = 2u;

@@ -42,6 +42,9 @@ pub mod region_flags {
     pub const SELECTION: u32 = 16;
     /// With [`SELECTION`]: weighted by 1 − the degree of interest.
     pub const KEEP_UNSELECTED: u32 = 32;
+    /// Another region is drawn in this one's samples (its record: `objects.z`;
+    /// `render::pack::companions`).
+    pub const COMPANION: u32 = 64;
 }
 
 /// Scene features: which parts of the shader a scene needs (shader defs).
@@ -71,9 +74,11 @@ pub mod features {
     /// Every selection weight's degree of interest lies in the second channel of its
     /// data's texels (`render::pack::doi_channels`): one fetch gives value and weight.
     pub const DOI_CHANNEL: u32 = 16384;
+    /// Some region draws another in its samples (`render::pack::companions`).
+    pub const COMPANION: u32 = 32768;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 15] = [
+    pub const NAMES: [(u32, &str); 16] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -89,6 +94,7 @@ pub mod features {
         (SELECTION, "HAS_SELECTION"),
         (HOLES, "HAS_HOLES"),
         (DOI_CHANNEL, "DOI_CHANNEL"),
+        (COMPANION, "COMPANION"),
     ];
 }
 
@@ -157,7 +163,8 @@ pub struct GpuRegion {
     /// Segmented regions ([`mode::TWO_LEVEL`]): index of the first part record (the
     /// objects, then the rest), the number of parts, and the index of the label
     /// record (the label volume with, per code, up to four candidate objects + 1);
-    /// `w`: with [`region_flags::SELECTION`], the index of the selection record (the
+    /// `z`, with [`region_flags::COMPANION`]: the record of the region drawn in this
+    /// one's samples; `w`: with [`region_flags::SELECTION`], the index of the selection record (the
     /// selection volume, its map from the data's voxel index, `lut_a·t + lut_b` the
     /// degree of interest of a normalised sample `t`).
     pub objects: UVec4,

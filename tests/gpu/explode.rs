@@ -61,8 +61,29 @@ fn exploded_halves(gpu: &mut Gpu, carried: bool) {
     };
     let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
     let features = focal::render::pack::pack(&scene, 2048).unwrap().features;
-    assert_eq!(features & focal::render::gpu_types::features::DOI_CHANNEL != 0, carried);
+    use focal::render::gpu_types::features::{COMPANION, DOI_CHANNEL};
+    assert_eq!(features & DOI_CHANNEL != 0, carried);
+    // At rest the selection is drawn in the parts' samples (render::pack::companions).
+    assert_eq!(features & COMPANION != 0, carried);
     assert_matches(&format!("exploded_at_rest_{carried}"), &at_rest, &cpu(gpu));
+    // At rest with the head nearly transparent and the selection drawn by a grey ramp:
+    // the selection, drawn in the parts' samples, shows through the head.
+    let skin = gpu.off.world_mut().get::<Dataset>(data).unwrap().appearance.clone();
+    gpu.off.world_mut().get_mut::<Dataset>(data).unwrap().appearance = skin.clone().with_opacity_scaled(0.02);
+    let vessels = gpu.off.world_mut().get::<Exploded>(data).unwrap().selection_look.clone();
+    let white = Appearance::new(Mode::Dvr, presets::builtin("grayscale_ramp").unwrap());
+    gpu.off.world_mut().get_mut::<Exploded>(data).unwrap().selection_look = Some(white);
+    let through = gpu.off.capture().unwrap();
+    assert_matches(&format!("exploded_see_through_{carried}"), &through, &cpu(gpu));
+    // (Without the selection's region the reference differs in more pixels than
+    // assert_matches lets pass, so a selection left out of the parts' samples fails it.)
+    let mut without = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
+    without.regions.retain(|r| without.appearances[r.appearance].selection.as_ref().is_none_or(|w| w.keep != focal::region::Keep::Selected));
+    let bare = render(&without, &cam, SIZE, SIZE).unwrap().to_image().unwrap();
+    let shown = through.pixels().zip(bare.pixels()).filter(|(p, q)| (0..3).any(|c| p[c].abs_diff(q[c]) > 6)).count();
+    assert!(shown > 41, "the selection shows through the head: {shown} pixels");
+    gpu.off.world_mut().get_mut::<Dataset>(data).unwrap().appearance = skin;
+    gpu.off.world_mut().get_mut::<Exploded>(data).unwrap().selection_look = vessels;
     gpu.off.world_mut().get_mut::<Exploded>(data).unwrap().coefficients.degree = 1.0;
     step(gpu.off.world_mut(), 400);
     let apart = gpu.off.capture().unwrap();

@@ -279,6 +279,30 @@ fn a_selection_on_its_datas_grid_rides_in_the_second_channel() {
     assert_eq!((packed.volumes.clone(), packed.doi_channels.clone()), (vec![0], vec![Some(1)]));
     assert_eq!(packed.regions[0].flags & region_flags::SELECTION, region_flags::SELECTION);
     assert_eq!(packed.regions[1].flags & region_flags::KEEP_UNSELECTED, 0);
+    // The selection's region lies in the data's with the same map: it is drawn in the
+    // data's samples (a record after the one region the ray traverses), and the data's
+    // region skips only bricks where neither draws.
+    assert_eq!(packed.region_count, 1);
+    assert_eq!((packed.regions[0].flags & region_flags::COMPANION, packed.regions[0].objects.z), (region_flags::COMPANION, 1));
+    assert_eq!(packed.features & (features::COMPANION | features::DVR_PAIRS | features::MULTI_REGION), features::COMPANION);
+    assert_eq!(packed.region_slots, vec![Some(0), Some(1)]);
+    let words = |r: &GpuRegion| &packed.occupancy[r.occupancy_offset as usize..][..v.bricks().len().div_ceil(32)];
+    assert!(words(&packed.regions[0]).iter().zip(words(&packed.regions[1])).all(|(a, b)| a & b == *b));
+    // Inside it but shifted by a voxel, it samples other voxels: a region of its own,
+    // paired with the data's.
+    let mut moved = scene_with(&on_grid, &on_grid);
+    let shifted = Region::volume_box_at(&v.grid, glam::Affine3A::from_translation(v.grid.spacing * Vec3::X), 0, 1);
+    moved.regions[1] = shifted.cut_to_index_box(Vec3::splat(-0.5), Vec3::new(13.5, 15.5, 15.5));
+    let packed = pack(&moved, 2048).unwrap();
+    assert_eq!((packed.region_count, packed.features & (features::COMPANION | features::DVR_PAIRS)), (2, features::DVR_PAIRS));
+    // Shaded otherwise than the data's look, it needs a gradient of its own: paired.
+    let mut glossy = scene_with(&on_grid, &on_grid);
+    glossy.appearances[1].shading.specular = 0.9;
+    assert_eq!(pack(&glossy, 2048).unwrap().features & (features::COMPANION | features::DVR_PAIRS), features::DVR_PAIRS);
+    // So is a look that modulates by the gradient.
+    let mut modulated = scene_with(&on_grid, &on_grid);
+    modulated.appearances[1].mode = Mode::GradientDvr;
+    assert_eq!(pack(&modulated, 2048).unwrap().features & features::COMPANION, 0);
     // On a grid of its own (twice as coarse): the weights sample it in its own box.
     let coarse = selected(Grid::new(glam::UVec3::splat(8), v.grid.spacing * 2.0));
     let packed = pack(&scene_with(&coarse, &coarse), 2048).unwrap();
