@@ -340,9 +340,10 @@ impl ExplodeSpec {
             SelectionSpec::Labels { dataset, ids } => {
                 let labels = label(*dataset).ok_or_else(|| format!("the selection's dataset {dataset} is not a label volume"))?;
                 let ids: BTreeSet<u32> = ids.iter().copied().collect();
-                let sel = SelectionVolume::from_labels(&labels, &ids)?;
+                // (On the data's grid: the label volume's may be another.)
+                let sel = SelectionVolume::from_labels(&labels, &ids)?.resampled(&data.grid)?;
                 if sel.volume.voxels.code_max() == 0 || !has_selected(&sel) {
-                    return Err(format!("no voxel of dataset {dataset} has the labels {ids:?}"));
+                    return Err(format!("no voxel of dataset {dataset} has the labels {ids:?} inside the data's box"));
                 }
                 sel
             }
@@ -469,6 +470,13 @@ mod tests {
         let bad: ExplodeSpec =
             ron::from_str("(selection: Range(lo: 0.0, hi: 1.0), parts: Planes([(normal: (0.0, 0.0, 0.0), offset: 1.0)]))").unwrap();
         assert!(bad.validate(1).unwrap_err().contains("plane 0"));
+        // Labels on a grid of their own (the head's at half the resolution): the
+        // selection comes on the data's grid.
+        let coarse = crate::volume::phantom::head::generate(16).unwrap().labels;
+        let by_label: ExplodeSpec = ron::from_str("(selection: Labels(dataset: 1, ids: [6, 7, 8]))").unwrap();
+        let moved = by_label.selection(&head, |_| Some(coarse.clone())).unwrap();
+        assert_eq!(moved.grid, head.grid);
+        assert!(moved.bricks().max.iter().any(|m| *m > 0));
         let far: ExplodeSpec = ron::from_str("(selection: Range(lo: 90000.0, hi: 99999.0))").unwrap();
         assert!(far.selection(&head, |_| None).unwrap_err().contains("no voxel"));
         let fixed: ExplodeSpec = ron::from_str("(selection: Range(lo: 300.0, hi: 4000.0), fixed: [1])").unwrap();

@@ -10,6 +10,7 @@ use std::collections::BTreeSet;
 
 use rayon::prelude::*;
 
+use super::sample::VolumeSampler;
 use super::{Grid, LabelVolume, Source, ValueMap, Volume, Voxels};
 
 /// Degree-of-interest volume.
@@ -52,6 +53,34 @@ impl SelectionVolume {
         Self::from_codes(volume.grid.clone(), codes)
     }
 
+    /// The selection on another grid (one made from a label volume on a grid other
+    /// than its data's, moved onto the data's: the explosion points, the GPU's second
+    /// channel and painting all take the data's grid): each voxel of `grid` takes the
+    /// degree of interest trilinearly sampled at its centre, 0 outside this selection's
+    /// box of voxel cells.
+    pub fn resampled(&self, grid: &Grid) -> Result<Self, String> {
+        if *grid == self.volume.grid {
+            return Ok(self.clone());
+        }
+        grid.validate()?;
+        let to_index = self.volume.grid.world_to_index() * grid.index_to_world();
+        let sampler = VolumeSampler::of(&self.volume);
+        let (lo, hi) = (glam::Vec3::splat(-0.5), self.volume.dims().as_vec3() - 0.5);
+        let d = grid.dims;
+        let codes = (0..grid.voxel_count())
+            .into_par_iter()
+            .map(|n| {
+                let (i, j, k) = (n as u32 % d.x, n as u32 / d.x % d.y, n as u32 / (d.x * d.y));
+                let p = to_index.transform_point3(glam::Vec3::new(i as f32, j as f32, k as f32));
+                if p.cmplt(lo).any() || p.cmpgt(hi).any() {
+                    return 0;
+                }
+                (sampler.trilinear(p) * 255.0).round().clamp(0.0, 255.0) as u8
+            })
+            .collect();
+        Self::from_codes(grid.clone(), codes)
+    }
+
     /// Degree of interest of voxel (i, j, k).
     pub fn doi(&self, i: u32, j: u32, k: u32) -> f32 {
         self.volume.code(i, j, k) as f32 / 255.0
@@ -85,6 +114,24 @@ mod tests {
     use super::*;
     use crate::volume::LabelTable;
     use glam::{UVec3, Vec3};
+
+    #[test]
+    fn a_selection_moves_onto_another_grid() {
+        // 4 voxels of 2 mm (centres 0, 2, 4, 6 mm) with voxel 1 selected, onto 1 mm
+        // voxels from −2 mm: centres at −2 (outside the box, which starts at −1), −1
+        // (the first cell's edge: voxel 0's 0), 2 (voxel 1: 255), 3 (half way: 128),
+        // 4 (voxel 2: 0) and 8 (outside).
+        let coarse = Grid::new(UVec3::new(4, 1, 1), Vec3::splat(2.0));
+        let s = SelectionVolume::from_codes(coarse.clone(), vec![0, 255, 0, 0]).unwrap();
+        let mut fine = Grid::new(UVec3::new(11, 1, 1), Vec3::ONE);
+        fine.origin = Vec3::new(-2.0, 0.0, 0.0);
+        let r = s.resampled(&fine).unwrap();
+        assert_eq!(r.volume.grid, fine);
+        let at = |mm: i32| r.volume.code((mm + 2) as u32, 0, 0);
+        assert_eq!((at(-2), at(-1), at(2), at(3), at(4), at(8)), (0, 0, 255, 128, 0, 0));
+        // On its own grid it is itself.
+        assert_eq!(s.resampled(&coarse).unwrap().volume.voxels, s.volume.voxels);
+    }
 
     #[test]
     fn selection_from_labels_and_ranges() {
