@@ -412,7 +412,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                     set_weight(region_weight(r));
 #endif
 #ifdef COMPANION
-                    set_companion(r, ray.dir, step);
+                    set_companion(r, ray.origin, ray.dir, step);
 #endif
                     for (var dvr_steps = 0u; dvr_steps < scene.max_steps; dvr_steps++) {
                         if kk > k_end || acc.a >= stop {

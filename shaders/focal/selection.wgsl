@@ -12,7 +12,7 @@
 #import focal::types::{Region, REGION_SELECTION, REGION_KEEP_UNSELECTED, REGION_COMPANION}
 #import focal::bindings::{regions, occupancy}
 #import focal::sampling::trilinear_box
-#import focal::regions::world_step
+#import focal::regions::{world_step, region_interval}
 
 const KEEP_NONE: u32 = 0u;
 const KEEP_SELECTED: u32 = 1u;
@@ -70,16 +70,24 @@ struct Companion {
     lut_ab: vec2<f32>,
     // Its opacity-correction ratio for the march step.
     ratio: f32,
+    // The ray's interval inside it: outside, the region adds nothing. (naga_oil
+    // refuses module field names that end in digits.)
+    t_enter: f32,
+    t_leave: f32,
     on: bool,
 }
 
 var<private> companion: Companion;
 
-// The companion of region r on a ray along dir marched at step (none when r has none).
-fn set_companion(r: Region, dir: vec3<f32>, step: f32) {
+// The companion of region r on a ray from origin along dir marched at step (none when r
+// has none).
+fn set_companion(r: Region, origin: vec3<f32>, dir: vec3<f32>, step: f32) {
     companion.on = (r.flags & REGION_COMPANION) != 0u;
     if companion.on {
         let c = regions[r.objects.z];
+        let iv = region_interval(c, origin, dir);
+        companion.t_enter = max(iv.x, 0.0);
+        companion.t_leave = iv.y;
         companion.lut_offset = c.lut_offset;
         companion.lut_width = c.lut_width;
         companion.lut_ab = vec2(c.lut_a, c.lut_b);

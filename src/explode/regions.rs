@@ -11,6 +11,11 @@
 //!   to the bricks its look can draw in ([`drawn_part`]);
 //! - only parts over the selection's non-zero bricks need its weight (elsewhere
 //!   `1 − doi` is 1: [`holds_selection`]).
+//!
+//! At rest the selection's region lies inside the parts' one region under the same
+//! map, and the GPU draws it in that region's samples (`render::pack::companions`);
+//! with the selection on the data's grid its degree of interest comes with the data's
+//! own fetch (`render::pack::doi_channels`).
 
 use glam::{Affine3A, Vec3};
 

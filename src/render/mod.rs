@@ -5,8 +5,10 @@
 //! - [`extract`] copies the scene (shared `Arc`s, small vectors) and each view's settings;
 //! - [`upload`] packs the scene ([`pack`], reusing the CPU reference's preparation) into
 //!   storage buffers and a lookup-table atlas, and uploads the volumes as 3D textures
-//!   (`R8Unorm`; `R16Unorm`, or `R16Float` where 16-bit normalised formats are missing)
-//!   with their brick min-max grids (`Rg16Uint`), only when something changed;
+//!   (`R8Unorm`; `R16Unorm`, or `R16Float` where 16-bit normalised formats are missing;
+//!   `Rg8Unorm`, `Rg16Unorm` or `Rg16Float` when a selection rides in a second channel,
+//!   [`pack::doi_channels`]) with their brick min-max grids (`Rg16Uint`), only when
+//!   something changed;
 //! - [`pass`] draws one full-screen triangle per view running `shaders/raycast.wgsl`,
 //!   after the opaque and transparent main passes so it reads their depth, blending the
 //!   premultiplied result over the meshes.

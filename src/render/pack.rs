@@ -53,7 +53,8 @@ pub struct PackedScene {
     /// Index in `regions` of every scene region (`None` for those dropped).
     pub region_slots: Vec<Option<u32>>,
     /// Regions the ray traverses: the first `region_count` of `regions` (the others
-    /// are records of segmentations).
+    /// are records: the regions drawn in others' samples ([`companions`]), the parts and
+    /// labels of segmentations, the selections of weights).
     pub region_count: u32,
     /// Shader features the regions need ([`super::gpu_types::features`]).
     pub features: u32,
@@ -518,11 +519,13 @@ fn meet(regions: &[&crate::region::Region]) -> bool {
 /// [`doi_channels`], the degree of interest) serves both looks, composited `a` then
 /// `b` as the reference's region order has them, and `b` costs the ray no region,
 /// segment or pair loop of its own (on llvmpipe ×1.15 → ×1.06 of the plain frame for
-/// an exploded head at rest). Outside `b` its look adds nothing: `b` is the box where
-/// the degree of interest is not 0, cut to the bricks its look draws in. Only where no
-/// third region meets `b` (its samples would come between them), neither has holes or
-/// objects, and `b` is plain DVR shaded as `a` is (it shares `a`'s gradient and
-/// Blinn-Phong terms). Per region: the one drawn in its samples.
+/// an exploded head at rest). The shader draws `b` where the ray is inside it (its
+/// interval, found once per segment). Only where `b` lies inside `a`, no third region
+/// meets `b` (its samples would come between them; one that only touches it can take
+/// a sample on their common face without `b`), neither has holes or objects, `b` is
+/// plain DVR shaded as `a` is (it shares `a`'s gradient and Blinn-Phong terms) and
+/// steps no finer than `a` (the ray's step is the finest of the regions it crosses, and
+/// `b` no longer counts). Per region: the one drawn in its samples.
 pub fn companions(prepared: &[PreparedRegion], carried: bool) -> Vec<Option<usize>> {
     use crate::region::{Keep, vertices};
     let n = prepared.len();
@@ -557,6 +560,7 @@ pub fn companions(prepared: &[PreparedRegion], carried: bool) -> Vec<Option<usiz
                 && pa.region.world_to_voxel.abs_diff_eq(pb.region.world_to_voxel, 1e-5)
                 && inside(pa)
                 && shaded_alike(pa)
+                && pb.native_step >= pa.native_step
         });
         let Some(a) = host else { continue };
         if (0..n).all(|c| c == a || c == b || !meet(&[pb.region, prepared[c].region])) {

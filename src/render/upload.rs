@@ -183,6 +183,22 @@ fn atlases(
     formats16: [TextureFormat; 2],
 ) -> GpuAtlases {
     let size = packed.atlas.size;
+    let (format, data) = volume_texels(volumes, packed, formats16);
+    let (vt, vv) = texture_3d(device, queue, "focal volume atlas", size, format, &data);
+    let bsize = packed.brick_atlas.size;
+    let mut bricks = vec![0u8; (bsize.x * bsize.y * bsize.z) as usize * 4];
+    for ((v, _), &o) in volumes.iter().zip(&packed.brick_atlas.offsets) {
+        let g = v.bricks();
+        let pairs: Vec<u8> = g.min.iter().zip(&g.max).flat_map(|(&lo, &hi)| [lo.to_le_bytes(), hi.to_le_bytes()].concat()).collect();
+        blit(&mut bricks, bsize, &pairs, g.dims, o, 4);
+    }
+    let (bt, bv) = texture_3d(device, queue, "focal brick atlas", bsize, TextureFormat::Rg16Uint, &bricks);
+    GpuAtlases { volumes: vv, bricks: bv, _textures: (vt, bt) }
+}
+
+/// The volume atlas's format and texels ([`atlases`]).
+fn volume_texels(volumes: &[(&Volume, Option<&Volume>)], packed: &PackedScene, formats16: [TextureFormat; 2]) -> (TextureFormat, Vec<u8>) {
+    let size = packed.atlas.size;
     let texels = (size.x * size.y * size.z) as usize;
     let channels = if volumes.iter().any(|(_, s)| s.is_some()) { 2 } else { 1 };
     let all = volumes.iter().flat_map(|(v, s)| std::iter::once(*v).chain(*s));
@@ -221,16 +237,7 @@ fn atlases(
             blit(&mut data, size, &texels, dims, o, bytes);
         }
     }
-    let (vt, vv) = texture_3d(device, queue, "focal volume atlas", size, format, &data);
-    let bsize = packed.brick_atlas.size;
-    let mut bricks = vec![0u8; (bsize.x * bsize.y * bsize.z) as usize * 4];
-    for ((v, _), &o) in volumes.iter().zip(&packed.brick_atlas.offsets) {
-        let g = v.bricks();
-        let pairs: Vec<u8> = g.min.iter().zip(&g.max).flat_map(|(&lo, &hi)| [lo.to_le_bytes(), hi.to_le_bytes()].concat()).collect();
-        blit(&mut bricks, bsize, &pairs, g.dims, o, 4);
-    }
-    let (bt, bv) = texture_3d(device, queue, "focal brick atlas", bsize, TextureFormat::Rg16Uint, &bricks);
-    GpuAtlases { volumes: vv, bricks: bv, _textures: (vt, bt) }
+    (format, data)
 }
 
 fn storage<T: bevy::render::render_resource::ShaderType + bevy::render::render_resource::encase::internal::WriteInto>(
@@ -287,4 +294,50 @@ fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScen
     );
     let view = texture.create_view(&TextureViewDescriptor::default());
     gpu.lut = Some((texture, view));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::pack::Atlas;
+    use crate::volume::{Grid, Source, ValueMap};
+
+    fn volume(voxels: Voxels) -> Volume {
+        Volume::new("v", Grid::new(UVec3::new(voxels.len() as u32, 1, 1), Vec3::ONE), voxels, ValueMap::IDENTITY, Source::default()).unwrap()
+    }
+
+    /// Two volumes side by side in an atlas of 5×1×1 texels, the first carrying a
+    /// selection.
+    fn packed() -> PackedScene {
+        PackedScene {
+            atlas: Atlas { size: UVec3::new(5, 1, 1), offsets: vec![UVec3::ZERO, UVec3::new(2, 0, 0)] },
+            levels: vec![vec![UVec3::ZERO], vec![UVec3::new(2, 0, 0)]],
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn a_selection_rides_in_the_second_channel_of_its_datas_texels() {
+        let (data, other) = (volume(Voxels::U8(vec![10, 20])), volume(Voxels::U8(vec![1, 2, 3])));
+        let selection = volume(Voxels::U8(vec![0, 255]));
+        let formats = [TextureFormat::R16Unorm, TextureFormat::Rg16Unorm];
+        // 8-bit: (value, doi) pairs; the other volume's second channel is 0.
+        let (format, bytes) = volume_texels(&[(&data, Some(&selection)), (&other, None)], &packed(), formats);
+        assert_eq!((format, bytes), (TextureFormat::Rg8Unorm, vec![10, 0, 20, 255, 1, 0, 2, 0, 3, 0]));
+        // Without a selection, one channel.
+        let (format, bytes) = volume_texels(&[(&data, None), (&other, None)], &packed(), formats);
+        assert_eq!((format, bytes), (TextureFormat::R8Unorm, vec![10, 20, 1, 2, 3]));
+        // 16-bit data: 8-bit codes become 257·c; half floats of code / 65535 where
+        // 16-bit normalised textures are missing.
+        let wide = volume(Voxels::U16(vec![1000, 65535]));
+        let (format, bytes) = volume_texels(&[(&wide, Some(&selection)), (&other, None)], &packed(), formats);
+        let words: Vec<u16> = bytes.chunks(2).map(|b| u16::from_le_bytes([b[0], b[1]])).collect();
+        assert_eq!((format, words), (TextureFormat::Rg16Unorm, vec![1000, 0, 65535, 65535, 257, 0, 514, 0, 771, 0]));
+        let floats = [TextureFormat::R16Float, TextureFormat::Rg16Float];
+        let (format, bytes) = volume_texels(&[(&wide, Some(&selection)), (&other, None)], &packed(), floats);
+        let halves: Vec<f32> = bytes.chunks(2).map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32()).collect();
+        assert_eq!(format, TextureFormat::Rg16Float);
+        let expected = [1000.0 / 65535.0, 0.0, 1.0, 1.0, 1.0 / 255.0, 0.0, 2.0 / 255.0, 0.0, 3.0 / 255.0, 0.0];
+        assert!(halves.iter().zip(expected).all(|(h, e)| (h - e).abs() <= 1e-3 * e.max(1e-3)), "{halves:?}");
+    }
 }

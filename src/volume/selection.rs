@@ -56,8 +56,10 @@ impl SelectionVolume {
     /// The selection on another grid (one made from a label volume on a grid other
     /// than its data's, moved onto the data's: the explosion points, the GPU's second
     /// channel and painting all take the data's grid): each voxel of `grid` takes the
-    /// degree of interest trilinearly sampled at its centre, 0 outside this selection's
-    /// box of voxel cells.
+    /// mean degree of interest of trilinear samples spread over its cell, one per
+    /// selection voxel its cell spans along each axis (at most 3, so a thin structure
+    /// of a finer label grid leaves a partial degree of interest instead of falling
+    /// between centres); 0 outside this selection's box of voxel cells.
     pub fn resampled(&self, grid: &Grid) -> Result<Self, String> {
         if *grid == self.volume.grid {
             return Ok(self.clone());
@@ -67,15 +69,26 @@ impl SelectionVolume {
         let sampler = VolumeSampler::of(&self.volume);
         let (lo, hi) = (glam::Vec3::splat(-0.5), self.volume.dims().as_vec3() - 0.5);
         let d = grid.dims;
+        let m = to_index.matrix3;
+        let n = [m.x_axis, m.y_axis, m.z_axis].map(|c| (c.length().ceil() as u32).clamp(1, 3));
+        let offsets: Vec<glam::Vec3> = (0..n[0] * n[1] * n[2])
+            .map(|s| {
+                let (a, b, c) = (s % n[0], s / n[0] % n[1], s / (n[0] * n[1]));
+                let at = |k: u32, n: u32| (k as f32 + 0.5) / n as f32 - 0.5;
+                glam::Vec3::new(at(a, n[0]), at(b, n[1]), at(c, n[2]))
+            })
+            .collect();
         let codes = (0..grid.voxel_count())
             .into_par_iter()
-            .map(|n| {
-                let (i, j, k) = (n as u32 % d.x, n as u32 / d.x % d.y, n as u32 / (d.x * d.y));
-                let p = to_index.transform_point3(glam::Vec3::new(i as f32, j as f32, k as f32));
-                if p.cmplt(lo).any() || p.cmpgt(hi).any() {
-                    return 0;
-                }
-                (sampler.trilinear(p) * 255.0).round().clamp(0.0, 255.0) as u8
+            .map(|v| {
+                let centre = glam::Vec3::new((v as u32 % d.x) as f32, (v as u32 / d.x % d.y) as f32, (v as u32 / (d.x * d.y)) as f32);
+                let sum: f32 = offsets
+                    .iter()
+                    .map(|o| to_index.transform_point3(centre + *o))
+                    .filter(|p| !(p.cmplt(lo).any() || p.cmpgt(hi).any()))
+                    .map(|p| sampler.trilinear(p))
+                    .sum();
+                (sum / offsets.len() as f32 * 255.0).round().clamp(0.0, 255.0) as u8
             })
             .collect();
         Self::from_codes(grid.clone(), codes)
@@ -129,6 +142,14 @@ mod tests {
         assert_eq!(r.volume.grid, fine);
         let at = |mm: i32| r.volume.code((mm + 2) as u32, 0, 0);
         assert_eq!((at(-2), at(-1), at(2), at(3), at(4), at(8)), (0, 0, 255, 128, 0, 0));
+        // Onto voxels of 3 mm along x (centres 1, 4, 7 mm) from 1 mm ones with voxel 3
+        // selected: the middle one spans 3, 4 and 5 mm, a third selected (a sample at
+        // its centre alone would miss it).
+        let thin = SelectionVolume::from_codes(Grid::new(UVec3::new(9, 1, 1), Vec3::ONE), (0..9).map(|i| if i == 3 { 255 } else { 0 }).collect()).unwrap();
+        let mut wide = Grid::new(UVec3::new(3, 1, 1), Vec3::new(3.0, 1.0, 1.0));
+        wide.origin = Vec3::new(1.0, 0.0, 0.0);
+        let r = thin.resampled(&wide).unwrap();
+        assert_eq!((r.volume.code(0, 0, 0), r.volume.code(1, 0, 0), r.volume.code(2, 0, 0)), (0, 85, 0));
         // On its own grid it is itself.
         assert_eq!(s.resampled(&coarse).unwrap().volume.voxels, s.volume.voxels);
     }

@@ -299,6 +299,10 @@ fn a_selection_on_its_datas_grid_rides_in_the_second_channel() {
     let mut glossy = scene_with(&on_grid, &on_grid);
     glossy.appearances[1].shading.specular = 0.9;
     assert_eq!(pack(&glossy, 2048).unwrap().features & (features::COMPANION | features::DVR_PAIRS), features::DVR_PAIRS);
+    // So is a look that steps finer than the data's: the ray takes its step.
+    let mut finer = scene_with(&on_grid, &on_grid);
+    finer.appearances[1].step = 0.25;
+    assert_eq!(pack(&finer, 2048).unwrap().features & (features::COMPANION | features::DVR_PAIRS), features::DVR_PAIRS);
     // So is a look that modulates by the gradient.
     let mut modulated = scene_with(&on_grid, &on_grid);
     modulated.appearances[1].mode = Mode::GradientDvr;
