@@ -82,6 +82,15 @@ fn exploded_halves(gpu: &mut Gpu, carried: bool) {
     let bare = render(&without, &cam, SIZE, SIZE).unwrap().to_image().unwrap();
     let shown = through.pixels().zip(bare.pixels()).filter(|(p, q)| (0..3).any(|c| p[c].abs_diff(q[c]) > 6)).count();
     assert!(shown > 41, "the selection shows through the head: {shown} pixels");
+    // The same under a magnifier whose border compresses (anti-aliased from the mip
+    // levels): the selection is drawn only inside its own region there too.
+    let lenses = [focal::lens::Lens::magnifier(Vec2::new(0.05, -0.05), 0.3, 0.25, 2.5)];
+    focal::lens::systems::replace_lenses(gpu.off.world_mut(), &lenses);
+    let lensed = gpu.off.capture().unwrap();
+    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
+    let cpu_lensed = focal::reference::render_lensed(&scene, &cam, &lenses, SIZE, SIZE).unwrap().to_image().unwrap();
+    assert_matches(&format!("exploded_see_through_lensed_{carried}"), &lensed, &cpu_lensed);
+    focal::lens::systems::replace_lenses(gpu.off.world_mut(), &[]);
     gpu.off.world_mut().get_mut::<Dataset>(data).unwrap().appearance = skin;
     gpu.off.world_mut().get_mut::<Exploded>(data).unwrap().selection_look = vessels;
     gpu.off.world_mut().get_mut::<Exploded>(data).unwrap().coefficients.degree = 1.0;
