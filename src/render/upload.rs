@@ -12,6 +12,8 @@ use bevy::render::render_resource::{
 };
 use bevy::render::renderer::{RenderAdapter, RenderDevice, RenderQueue};
 
+use rayon::prelude::*;
+
 use super::extract::ExtractedScene;
 use super::gpu_types::GpuSceneInfo;
 use super::pack::{LUT_ATLAS_WIDTH, PackedScene, pack};
@@ -208,16 +210,17 @@ fn volume_texels(volumes: &[(&Volume, Option<&Volume>)], packed: &PackedScene, f
         (false, _) => (TextureFormat::Rg8Unorm, 2),
         (true, c) => (formats16[c - 1], 2 * c),
     };
-    let push = |out: &mut Vec<u8>, c: u16, bits: u32| {
+    // One channel of a texel.
+    let write = |out: &mut [u8], c: u16, bits: u32| {
         if !sixteen {
-            out.push(c as u8);
+            out[0] = c as u8;
             return;
         }
         let c = c as u32 * if bits == 8 { 257 } else { 1 };
-        match format {
-            TextureFormat::R16Unorm | TextureFormat::Rg16Unorm => out.extend((c as u16).to_le_bytes()),
-            _ => out.extend(half::f16::from_f32(c as f32 / 65535.0).to_le_bytes()),
-        }
+        out.copy_from_slice(&match format {
+            TextureFormat::R16Unorm | TextureFormat::Rg16Unorm => (c as u16).to_le_bytes(),
+            _ => half::f16::from_f32(c as f32 / 65535.0).to_le_bytes(),
+        });
     };
     let mut data = vec![0u8; texels * bytes];
     for (slot, (v, second)) in volumes.iter().enumerate() {
@@ -227,13 +230,25 @@ fn volume_texels(volumes: &[(&Volume, Option<&Volume>)], packed: &PackedScene, f
                 continue;
             }
             let second = second.filter(|s| level == 0 && s.voxels.len() == voxels.len());
-            let mut texels = Vec::with_capacity(voxels.len() * bytes);
-            for i in 0..voxels.len() {
-                push(&mut texels, voxels.code(i), v.voxels.bits());
-                if channels == 2 {
-                    push(&mut texels, second.map_or(0, |s| s.voxels.code(i)), second.map_or(8, |s| s.voxels.bits()));
-                }
+            let mut texels = vec![0u8; voxels.len() * bytes];
+            if !sixteen {
+                // (8-bit codes as they are, interleaved: a paint stroke uploads the atlas
+                // again, and this is most of that time.)
+                let g = second.map(|s| s.voxels.as_bytes());
+                texels.par_chunks_mut(2).zip(voxels.as_bytes().par_iter()).enumerate().for_each(|(i, (t, r))| {
+                    t[0] = *r;
+                    t[1] = g.map_or(0, |g| g[i]);
+                });
+                blit(&mut data, size, &texels, dims, o, bytes);
+                continue;
             }
+            texels.par_chunks_mut(bytes).enumerate().for_each(|(i, t)| {
+                let (value, rest) = t.split_at_mut(bytes / channels);
+                write(value, voxels.code(i), v.voxels.bits());
+                if let Some(s) = second {
+                    write(rest, s.voxels.code(i), s.voxels.bits());
+                }
+            });
             blit(&mut data, size, &texels, dims, o, bytes);
         }
     }
