@@ -548,8 +548,10 @@ pub fn companions(prepared: &[PreparedRegion], carried: bool) -> Vec<Option<usiz
         if !keeps(pb, Keep::Selected) || pb.mode != Mode::Dvr || corners.is_empty() {
             continue;
         }
-        let shaded_alike = |pa: &PreparedRegion| pa.shading.enabled == pb.shading.enabled && (!pb.shading.enabled || pa.shading == pb.shading);
-        let inside = |pa: &PreparedRegion| corners.iter().all(|p| pa.region.planes.iter().all(|pl| pl.distance(*p) <= 1e-4 * (1.0 + p.length())));
+        let shaded_alike =
+            |pa: &PreparedRegion| pa.shading.enabled == pb.shading.enabled && (!pb.shading.enabled || pa.shading == pb.shading);
+        let inside =
+            |pa: &PreparedRegion| corners.iter().all(|p| pa.region.planes.iter().all(|pl| pl.distance(*p) <= 1e-4 * (1.0 + p.length())));
         let host = (0..b).find(|&a| {
             let pa = &prepared[a];
             out[a].is_none()

@@ -318,7 +318,8 @@ mod tests {
     use crate::volume::{Grid, Source, ValueMap};
 
     fn volume(voxels: Voxels) -> Volume {
-        Volume::new("v", Grid::new(UVec3::new(voxels.len() as u32, 1, 1), Vec3::ONE), voxels, ValueMap::IDENTITY, Source::default()).unwrap()
+        Volume::new("v", Grid::new(UVec3::new(voxels.len() as u32, 1, 1), Vec3::ONE), voxels, ValueMap::IDENTITY, Source::default())
+            .unwrap()
     }
 
     /// Two volumes side by side in an atlas of 5×1×1 texels, the first carrying a

@@ -145,7 +145,9 @@ mod tests {
         // Onto voxels of 3 mm along x (centres 1, 4, 7 mm) from 1 mm ones with voxel 3
         // selected: the middle one spans 3, 4 and 5 mm, a third selected (a sample at
         // its centre alone would miss it).
-        let thin = SelectionVolume::from_codes(Grid::new(UVec3::new(9, 1, 1), Vec3::ONE), (0..9).map(|i| if i == 3 { 255 } else { 0 }).collect()).unwrap();
+        let thin =
+            SelectionVolume::from_codes(Grid::new(UVec3::new(9, 1, 1), Vec3::ONE), (0..9).map(|i| if i == 3 { 255 } else { 0 }).collect())
+                .unwrap();
         let mut wide = Grid::new(UVec3::new(3, 1, 1), Vec3::new(3.0, 1.0, 1.0));
         wide.origin = Vec3::new(1.0, 0.0, 0.0);
         let r = thin.resampled(&wide).unwrap();

@@ -78,7 +78,9 @@ fn exploded_halves(gpu: &mut Gpu, carried: bool) {
     // (Without the selection's region the reference differs in more pixels than
     // assert_matches lets pass, so a selection left out of the parts' samples fails it.)
     let mut without = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
-    without.regions.retain(|r| without.appearances[r.appearance].selection.as_ref().is_none_or(|w| w.keep != focal::region::Keep::Selected));
+    without
+        .regions
+        .retain(|r| without.appearances[r.appearance].selection.as_ref().is_none_or(|w| w.keep != focal::region::Keep::Selected));
     let bare = render(&without, &cam, SIZE, SIZE).unwrap().to_image().unwrap();
     let shown = through.pixels().zip(bare.pixels()).filter(|(p, q)| (0..3).any(|c| p[c].abs_diff(q[c]) > 6)).count();
     assert!(shown > 41, "the selection shows through the head: {shown} pixels");

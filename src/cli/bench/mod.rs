@@ -280,7 +280,15 @@ fn push_group(rows: &mut Vec<Row>, group: &'static str, names: &[&str], ms: &[f6
     let base = names[0].to_string();
     for (i, (name, t)) in names.iter().zip(ms).enumerate() {
         let note = if i == 0 { base_note } else { note };
-        rows.push(Row { group, config: name.to_string(), ms: *t, baseline: base.clone(), ratio: t / ms[0].max(1e-9), sample_ratio: None, note: note.into() });
+        rows.push(Row {
+            group,
+            config: name.to_string(),
+            ms: *t,
+            baseline: base.clone(),
+            ratio: t / ms[0].max(1e-9),
+            sample_ratio: None,
+            note: note.into(),
+        });
     }
 }
 
