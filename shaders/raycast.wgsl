@@ -37,7 +37,7 @@
 #import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod}
 #import focal::regions::{region_interval, hole_interval, meets_sphere, pick_region, to_voxel, dir_to_voxel, world_step}
 #import focal::sampling::{trilinear, brick_occupied, brick_range, at_full_resolution}
-#import focal::selection::{Weight, region_weight, set_weight, pick_weight, set_companion, no_companion}
+#import focal::selection::{region_weight, set_weight, pick_weight, set_companion, no_companion}
 #import focal::samples::{is_projection, dvr_sample, is_dvr_like, iso_hit, emit_projection}
 #import focal::segments::{DONE, HAS_PREV, PAIRABLE, CLOSES, Segment, segment_t, segment_point, past_brick, past_empty_bricks, past_empty_pair, cut_intervals, compact_intervals, leaves}
 #ifdef HAS_TWO_LEVEL
@@ -246,9 +246,6 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
             var kk = k;
 #ifdef HAS_TWO_LEVEL
             if r.mode == MODE_TWO_LEVEL {
-#ifdef HAS_SELECTION
-                set_weight(Weight());
-#endif
                 var o = opens[s];
                 let labels = regions[r.objects.z];
                 var part = open_part(r, o);
@@ -454,9 +451,6 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
             let leaving = leaves(t_start, k, j, step, t1s[s]);
 #ifdef HAS_TWO_LEVEL
             if r.mode == MODE_TWO_LEVEL {
-#ifdef HAS_SELECTION
-                set_weight(Weight());
-#endif
                 var o = opens[s];
                 var part = open_part(r, o);
                 if !skip || (r.flags & REGION_OCCUPANCY) == 0u || !at_full_resolution() || brick_occupied(r, q) {

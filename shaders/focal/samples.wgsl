@@ -70,12 +70,11 @@ fn dvr_sample(r: Region, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f
 }
 
 // dvr_sample after classification: value v (0 for labels) gave rgba, whose opacity
-// takes `weight`. With COMPANION the current companion region's look follows at the
-// same voxel, where the ray is inside it, with the 1 − weight left over
-// (render::pack::companions: the same volume
-// under the same map, a DVR look with the same shading, so it shares the gradient and
-// the Blinn-Phong terms; on llvmpipe a second shading of its own cost a third of the
-// frame).
+// takes `weight` (1 for segmented regions' parts). With COMPANION the current
+// companion region's look follows at the same voxel, where the ray is inside it, with
+// the 1 − weight left over (render::pack::companions: the same volume under the same
+// map, a DVR look with the same shading, so it shares the gradient and the Blinn-Phong
+// terms; on llvmpipe a second shading of its own cost a third of the frame).
 fn dvr_classified(r: Region, q: vec3<f32>, v: f32, rgba: vec4<f32>, weight: f32, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
     let a = rgba.a * weight;
     var other = vec4(0.0);

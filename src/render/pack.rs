@@ -244,8 +244,8 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.regions[index].objects.w = pack_selection(p, slot, &mut out);
     }
     // (A region drawn in another's samples overlaps nothing of its own.)
-    let traversed: Vec<&PreparedRegion> = prepared.iter().enumerate().filter(|(i, _)| !drawn_in[*i]).map(|(_, p)| p).collect();
-    out.features = scene_features(&out.regions, overlaps(&traversed));
+    let walked: Vec<&PreparedRegion> = prepared.iter().enumerate().filter(|(i, _)| !drawn_in[*i]).map(|(_, p)| p).collect();
+    out.features = scene_features(&out.regions, overlaps(&walked));
     if fused.iter().any(Option::is_some) {
         out.features |= super::gpu_types::features::COMPANION;
     }
