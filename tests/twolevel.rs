@@ -10,8 +10,8 @@ use std::sync::Arc;
 
 use focal::reference::{DEPTH_THRESHOLD, RenderScene, prepare, trace};
 use focal::region::{Appearance, Light, Mode, Ray};
+use focal::region::{Object, Segmentation};
 use focal::transfer::{ColorPoint, OpacityPoint, TransferFunction, ValueSpace};
-use focal::twolevel::{Object, Segmentation};
 use focal::volume::{Grid, Source, ValueMap, Volume, Voxels};
 use glam::{UVec3, Vec3};
 

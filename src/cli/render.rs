@@ -5,8 +5,9 @@ use focal::context::ContextParams;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use focal::region::{AppearanceSpec, LabelsSpec};
 use focal::region::{Mode, Shading, View};
-use focal::scene::file::{AppearanceSpec, CameraSpec, DatasetSpec, LabelsSpec, RenderingSpec, SceneFile, SourceSpec};
+use focal::scene::file::{CameraSpec, DatasetSpec, RenderingSpec, SceneFile, SourceSpec};
 use focal::scene::run::{RunOptions, render_frames, render_scene_file};
 use focal::volume::phantom::Phantom;
 

@@ -6,7 +6,7 @@
 //! dataset. Each enabled plane keeps the half-space `n · p ≤ n · point` (the side its
 //! normal points away from; `flip` swaps the sides); the box keeps what lies inside it.
 //! The region model cuts the dataset's region by these as extra planes
-//! ([`Clipping::world_planes`]), so the CPU reference and the ray caster clip alike with
+//! ([`Clipping::world_planes`], [`Clipping::region`]), so the CPU reference and the ray caster clip alike with
 //! no code of their own.
 
 pub mod gizmo;
@@ -14,7 +14,8 @@ pub mod gizmo;
 use glam::{Affine3A, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::region::Plane;
+use crate::region::{Plane, Region};
+use crate::volume::Grid;
 
 /// One clip plane.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -109,6 +110,14 @@ impl Clipping {
         let local = self.planes.iter().filter(|p| p.enabled).map(ClipPlane::plane);
         let boxed = self.clip_box.filter(|b| b.enabled).map(|b| b.planes()).into_iter().flatten();
         local.chain(boxed).map(|p| transform_plane(&p, transform)).collect()
+    }
+
+    /// A dataset's region: the box of its volume on `grid` placed by `transform`, cut by
+    /// this clipping (one region per dataset; the volume and appearance share `index`).
+    pub fn region(&self, grid: &Grid, transform: Affine3A, index: usize) -> Region {
+        let mut region = Region::volume_box_at(grid, transform, index, index);
+        region.planes.extend(self.world_planes(&transform));
+        region
     }
 }
 

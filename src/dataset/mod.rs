@@ -8,14 +8,17 @@
 //! parts) add or replace regions after it, in [`RegionSystems::Modify`].
 
 pub mod gpu_fit;
+pub mod view;
 
 use std::sync::Arc;
 
 use bevy::prelude::*;
 
 use crate::clip::Clipping;
-use crate::region::{Appearance, Light, Region, RenderScene};
+use crate::region::{Appearance, Light, RenderScene};
 use crate::volume::{LabelTable, Volume};
+
+pub use view::VolumeView;
 
 /// A volume in the scene.
 #[derive(Component, Clone)]
@@ -79,7 +82,7 @@ pub fn collect_regions(
         }
         let volume = gpu.map(|g| g.volume.clone()).unwrap_or_else(|| d.volume.clone());
         let index = scene.volumes.len();
-        scene.regions.push(Region::dataset(&volume.grid, transform.affine(), &d.clip, index));
+        scene.regions.push(d.clip.region(&volume.grid, transform.affine(), index));
         scene.volumes.push(volume);
         scene.appearances.push(d.appearance.clone());
         entities.push(entity);

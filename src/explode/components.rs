@@ -109,8 +109,3 @@ impl Default for ExplodeTiming {
         ExplodeTiming { steps_per_second: 120.0, max_steps_per_frame: 4 }
     }
 }
-
-/// The scene-file spec an exploded dataset was made from (its selection and look; the
-/// parts and joints it has now are in the world: `edit::current_spec`).
-#[derive(Component, Clone, Debug)]
-pub struct ExplodeSource(pub super::spec::ExplodeSpec);

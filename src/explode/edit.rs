@@ -15,11 +15,11 @@
 use bevy::prelude::*;
 use glam::Affine3A;
 
-use super::components::{ExplodeSource, Exploded, Part};
+use super::components::{Exploded, Part};
 use super::joints::{GroupJoint, PartJoint};
 use super::paint::{Brush, Stroke, paint};
 use super::parts::Polyhedron;
-use super::spec::{ExplodeSpec, LoadedExplode, PartsSpec, PlaneSpec, replace_explosion};
+use super::spec::{ExplodeSource, ExplodeSpec, LoadedExplode, PartsSpec, PlaneSpec, replace_explosion};
 use super::splitters::{ScreenAxis, axis_plane, depth_plane, in_part_frame, line_plane, segment_crosses};
 use super::systems::spawn_part;
 use crate::dataset::{Dataset, SceneRegions};

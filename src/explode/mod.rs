@@ -12,6 +12,7 @@
 //! - [`points`]: explosion points from the data's and the selection's min-max octrees;
 //! - [`regions`]: parts as regions of the ray caster;
 //! - [`components`], [`systems`]: parts as rapier rigid bodies, the forces of each step;
+//! - [`plugin`]: the schedule that runs them;
 //! - [`joints`]: slider, hinge, ball, universal and fixed joints (section 3.3), groups;
 //! - [`spec`]: exploded views in scene files;
 //! - [`edit`]: exploding, the splitters applied to the parts, undo (the app's edits).
@@ -25,6 +26,7 @@ pub mod forces;
 pub mod joints;
 pub mod paint;
 pub mod parts;
+pub mod plugin;
 pub mod points;
 pub mod regions;
 pub mod spec;
@@ -33,4 +35,5 @@ pub mod systems;
 
 pub use components::{ExplodeTiming, Exploded, ExplosionPoints, Part};
 pub use joints::{JointKind, PartJoint};
-pub use systems::{ExplodePlugin, ExplodeStep, step};
+pub use plugin::ExplodePlugin;
+pub use systems::{ExplodeStep, step};

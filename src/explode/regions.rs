@@ -180,7 +180,7 @@ mod tests {
         assert!(selection_box(&SelectionVolume::empty(g.clone()).volume).is_none());
         // Its region in a dataset moved 100 mm along z: the box moved too.
         let dataset = Affine3A::from_translation(Vec3::new(0.0, 0.0, 100.0));
-        let whole = Region::dataset(&g, dataset, &Clipping::default(), 0);
+        let whole = Region::volume_box_at(&g, dataset, 0, 0);
         let r = selection_region(whole, &planes, dataset);
         let at = |q: Vec3| dataset.transform_point3(to_world.transform_point3(q));
         assert!(r.contains(at(Vec3::new(11.0, 4.0, 4.0))) && !r.contains(at(Vec3::new(20.0, 4.0, 4.0))));

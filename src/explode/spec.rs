@@ -40,8 +40,7 @@ use super::joints::{JointKind, PartJoint};
 use super::paint::{Stroke, paint_strokes};
 use super::parts::Polyhedron;
 use super::systems::{spawn_part, volume_polyhedron};
-use crate::region::{Appearance, Plane};
-use crate::scene::file::AppearanceSpec;
+use crate::region::{Appearance, AppearanceSpec, Plane};
 use crate::volume::{LabelVolume, SelectionVolume, Volume};
 
 /// An exploded view of a dataset.
@@ -82,6 +81,11 @@ pub struct ExplodeSpec {
     #[serde(default)]
     pub joints: Vec<JointSpec>,
 }
+
+/// The scene-file spec an exploded dataset was made from (its selection and look; the
+/// parts and joints it has now are in the world: `edit::current_spec`).
+#[derive(Component, Clone, Debug)]
+pub struct ExplodeSource(pub ExplodeSpec);
 
 /// A joint in a scene file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -413,10 +417,10 @@ pub fn replace_explosion(world: &mut World, dataset: Entity, loaded: Option<&Loa
         world.despawn(e);
     }
     let Some(loaded) = loaded else {
-        world.entity_mut(dataset).remove::<(Exploded, super::components::ExplosionPoints, super::components::ExplodeSource)>();
+        world.entity_mut(dataset).remove::<(Exploded, super::components::ExplosionPoints, ExplodeSource)>();
         return Vec::new();
     };
-    world.entity_mut(dataset).insert((loaded.exploded.clone(), super::components::ExplodeSource(loaded.spec.clone())));
+    world.entity_mut(dataset).insert((loaded.exploded.clone(), ExplodeSource(loaded.spec.clone())));
     let spec = &loaded.spec;
     let group = |i: usize| spec.groups.iter().position(|g| g.contains(&i)).map(|g| g as u32);
     let entities: Vec<Entity> = loaded

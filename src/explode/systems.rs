@@ -7,22 +7,20 @@
 //! `max_steps_per_frame`); tests and scripted scenes call [`step`] by hand. Parts do not
 //! collide (they start touching everywhere; the spacing force keeps them apart).
 
-use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
+use bevy::ecs::schedule::ScheduleLabel;
 use bevy::math::Affine3A;
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
-use bevy_rapier3d::rapier::dynamics::IntegrationParameters;
 
 use super::components::{ExplodeTiming, Exploded, ExplosionPoints, Part, PartFade};
 use super::forces::fade;
 use super::forces::{PartNow, Scale, Surroundings, Wrench, part_wrench};
-use super::joints::{build_joints, group_joints};
 use super::parts::Polyhedron;
 use super::points::explosion_points;
 use super::regions::{
     PlacedPart, drawn_part, holds_selection, moving_as_one, part_regions, selection_box, selection_region, spatial_order,
 };
-use crate::dataset::{Dataset, GpuVolume, RegionSystems, SceneRegions};
+use crate::dataset::{Dataset, GpuVolume, SceneRegions};
 use crate::region::{Appearance, Keep, Region, SelectionWeight, box_planes};
 use crate::transfer::Lut;
 use crate::volume::Volume;
@@ -31,45 +29,6 @@ use crate::windows::Viewer;
 /// The schedule of one physics step.
 #[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
 pub struct ExplodeStep;
-
-/// Exploded views (no GPU needed): rapier in [`ExplodeStep`], zero gravity, millimetres.
-pub struct ExplodePlugin;
-
-impl Plugin for ExplodePlugin {
-    fn build(&self, app: &mut App) {
-        let timing = ExplodeTiming::default();
-        let init = RapierContextInitialization::InitializeDefaultRapierContext {
-            integration_parameters: IntegrationParameters { length_unit: 1000.0, ..default() },
-            rapier_configuration: RapierConfiguration { gravity: Vec3::ZERO, ..RapierConfiguration::new(1000.0) },
-        };
-        app.add_plugins(RapierPhysicsPlugin::<NoUserData>::default().with_custom_initialization(init).in_schedule(ExplodeStep))
-            .insert_resource(TimestepMode::Fixed { dt: 1.0 / timing.steps_per_second, substeps: 1 })
-            .insert_resource(timing)
-            .add_systems(ExplodeStep, apply_forces.before(PhysicsSet::SyncBackend))
-            // One thread runs the step's systems (apply_forces spreads the parts over
-            // rayon's): waking the executor's threads for each of rapier's small
-            // systems cost more than they do.
-            .edit_schedule(ExplodeStep, |s| {
-                s.set_executor(SingleThreadedExecutor::new());
-            })
-            .init_resource::<super::edit::ExplodeEdits>()
-            .init_resource::<super::edit::CurrentSpecs>()
-            .add_systems(
-                Update,
-                (
-                    super::edit::apply_edits,
-                    ensure_parts,
-                    group_joints,
-                    build_joints,
-                    update_points,
-                    sync_bodies,
-                    super::edit::update_current_specs,
-                )
-                    .chain(),
-            )
-            .add_systems(PostUpdate, exploded_regions.in_set(RegionSystems::Modify).before(crate::windows::systems::window_regions));
-    }
-}
 
 /// Runs `n` physics steps.
 pub fn step(world: &mut World, n: u32) {
@@ -358,7 +317,7 @@ pub fn exploded_regions(
         }
         if let Some(b) = &selection_box {
             let look = weighted(x.selection_look.as_ref().unwrap_or(&own), Keep::Selected);
-            let dataset = Region { appearance: scene.appearances.len(), ..Region::dataset(grid, global.affine(), &d.clip, volume_index) };
+            let dataset = Region { appearance: scene.appearances.len(), ..d.clip.region(grid, global.affine(), volume_index) };
             if let Some(region) = drawn_part(selection_region(dataset, b, global.affine()), &look, &shown(d, gpu)) {
                 scene.appearances.push(look);
                 regions.push(region);

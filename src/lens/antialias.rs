@@ -37,7 +37,8 @@
 
 use glam::Vec3;
 
-use super::stack::{ResolvedLens, Screen, lens_ray};
+use super::screen::Screen;
+use super::stack::{ResolvedLens, lens_ray};
 use crate::region::{Camera, Ray};
 
 /// Differentials of a pixel's rays and the map from ray parameter to view depth.

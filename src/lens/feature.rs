@@ -30,9 +30,8 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::stack::Screen;
+use super::screen::Screen;
 use crate::region::{Camera, RenderScene};
-use crate::volume::sample::VolumeSampler;
 
 /// Rows of the feature grid (columns follow the aspect ratio).
 pub const FIELD_ROWS: u32 = 96;
@@ -283,7 +282,7 @@ pub fn feature_mask(scene: &RenderScene, job: &FeatureJob, camera: &Camera, scre
     let (cols, rows) = (job.grid.cols, job.grid.rows);
     let Some(region) = scene.regions.get(job.region as usize) else { return vec![false; job.grid.cells()] };
     let Some(volume) = scene.volumes.get(region.volume) else { return vec![false; job.grid.cells()] };
-    let sampler = VolumeSampler::of(volume);
+    let sampler = volume.sampler();
     let (label, step) = (job.label, job.step);
     (0..rows * cols)
         .into_par_iter()

@@ -12,7 +12,8 @@
 
 use glam::Vec2;
 
-use super::stack::{ResolvedLens, Screen, lens_ray};
+use super::screen::Screen;
+use super::stack::{ResolvedLens, lens_ray};
 use crate::region::Camera;
 
 /// Most lines one sample cell may hold per field (more means the lattice is too fine).

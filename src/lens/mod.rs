@@ -16,7 +16,8 @@
 //! - [`antialias`]: mip levels where a lens compresses (eq. 4);
 //! - [`feature`]: the feature lens, shaped by a segmented feature's silhouette (§3.2);
 //! - [`handles`]: grabbing, dragging and drawing lenses in the viewport;
-//! - [`lattice`]: the lens-distorted lattice overlay.
+//! - [`lattice`]: the lens-distorted lattice overlay;
+//! - [`screen`]: the image plane in lens coordinates.
 
 pub mod angular;
 pub mod antialias;
@@ -26,6 +27,7 @@ pub mod lattice;
 pub mod magnifier;
 pub mod profile;
 pub mod sampling;
+pub mod screen;
 pub mod shape;
 pub mod spec;
 pub mod stack;
@@ -33,7 +35,8 @@ pub mod systems;
 
 pub use profile::Profile;
 pub use sampling::Sampling;
+pub use screen::Screen;
 pub use shape::Shape;
 pub use spec::{Lens, LensKind};
-pub use stack::{MAX_LENSES, ResolvedLens, Screen, lens_ray, local_magnification};
+pub use stack::{MAX_LENSES, ResolvedLens, lens_ray, local_magnification};
 pub use systems::{LensPlugin, ViewLenses};

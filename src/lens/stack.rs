@@ -16,45 +16,13 @@ use super::angular::fisheye;
 use super::feature::{FeatureField, FeatureJob, feature_mask};
 use super::magnifier::Magnifier;
 use super::sampling::{TABLE_SIZE, lookup};
+use super::screen::Screen;
 use super::shape::Shape;
 use super::spec::{Lens, LensKind};
 use crate::region::{Camera, Projection, Ray, RenderScene};
 
 /// Most lenses per view (the GPU keeps them in the view uniform).
 pub const MAX_LENSES: usize = 4;
-
-/// An image of `width × height` pixels and its lens coordinates.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Screen {
-    pub width: f32,
-    pub height: f32,
-}
-
-impl Screen {
-    pub fn new(width: u32, height: u32) -> Screen {
-        Screen { width: width.max(1) as f32, height: height.max(1) as f32 }
-    }
-
-    pub fn aspect(&self) -> f32 {
-        self.width / self.height
-    }
-
-    /// Lens coordinates of pixel position `(px, py)` (top-left origin).
-    pub fn to_lens(&self, px: f32, py: f32) -> Vec2 {
-        Vec2::new((2.0 * px / self.width - 1.0) * self.aspect(), 1.0 - 2.0 * py / self.height)
-    }
-
-    /// Pixel position of lens coordinates `s`.
-    pub fn to_pixel(&self, s: Vec2) -> (f32, f32) {
-        ((s.x / self.aspect() + 1.0) * 0.5 * self.width, (1.0 - s.y) * 0.5 * self.height)
-    }
-
-    /// The camera's own ray through lens coordinates `s`.
-    pub fn camera_ray(&self, camera: &Camera, s: Vec2) -> Ray {
-        let (px, py) = self.to_pixel(s);
-        camera.ray(px, py, self.width as u32, self.height as u32)
-    }
-}
 
 /// What a resolved lens does.
 #[derive(Clone, Debug, PartialEq)]

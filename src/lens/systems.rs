@@ -3,11 +3,11 @@
 use bevy::camera::CameraUpdateSystems;
 use bevy::prelude::*;
 
+use super::screen::Screen;
 use super::spec::Lens;
-use super::stack::{MAX_LENSES, ResolvedLens, Screen, Silhouettes, resolve_with};
-use crate::dataset::SceneRegions;
+use super::stack::{MAX_LENSES, ResolvedLens, Silhouettes, resolve_with};
+use crate::dataset::{SceneRegions, VolumeView};
 use crate::region::{Camera as FocalCamera, Projection as FocalProjection};
-use crate::render::VolumeView;
 
 /// The lenses of one view, resolved for its camera this frame (in lens order).
 #[derive(Component, Clone, Debug, Default, PartialEq)]

@@ -103,7 +103,7 @@ pub fn label_at(scene: &RenderScene, hit: &Hit) -> Option<u32> {
     let q = region.world_to_voxel.transform_point3(hit.position);
     match (&appearance.lookup, &appearance.segmentation) {
         (_, Some(seg)) => seg.label_at(&volume.grid, q),
-        (crate::region::Lookup::Labels(_), None) => Some(crate::volume::sample::VolumeSampler::of(volume).nearest(q) as u32),
+        (crate::region::Lookup::Labels(_), None) => Some(volume.sampler().nearest(q) as u32),
         _ => None,
     }
 }

@@ -4,9 +4,9 @@
 use glam::{Affine3A, Mat3, Vec3};
 
 use crate::context::ContextParams;
+use crate::region::ObjectTable;
 use crate::region::{Appearance, Lookup, Mode, Region, Shading};
 use crate::transfer::Lut;
-use crate::twolevel::ObjectTable;
 use crate::volume::pyramid::level_index;
 use crate::volume::sample::VolumeSampler;
 use crate::volume::{BrickGrid, Volume};
@@ -123,7 +123,7 @@ impl<'a> PreparedRegion<'a> {
             visible.push(seg.rest_visible);
             p.objects = Some(PreparedObjects {
                 table: seg.table(volume),
-                labels: VolumeSampler::of(&seg.labels),
+                labels: seg.labels.sampler(),
                 label_volume: &seg.labels,
                 data_to_label: seg.data_to_label(&volume.grid),
                 parts,
@@ -153,7 +153,7 @@ impl<'a> PreparedRegion<'a> {
         PreparedRegion {
             region,
             volume,
-            sampler: VolumeSampler::of(volume),
+            sampler: volume.sampler(),
             lookup,
             mode,
             shading: appearance.shading,
@@ -169,7 +169,7 @@ impl<'a> PreparedRegion<'a> {
             objects: None,
             weight: appearance.selection.as_ref().map(|w| PreparedWeight {
                 weight: w,
-                sampler: VolumeSampler::of(&w.volume),
+                sampler: w.volume.sampler(),
                 data_to_selection: w.volume.grid.world_to_index() * volume.grid.index_to_world(),
             }),
         }

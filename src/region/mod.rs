@@ -9,12 +9,16 @@
 //! by the CPU reference renderer, the GPU packing and the techniques that make regions.
 
 pub mod appearance;
+pub mod appearance_spec;
 pub mod camera;
 pub mod scene;
 
 use glam::{Affine3A, Vec3};
 
-pub use appearance::{Appearance, Keep, Light, Lookup, Mode, SelectionWeight, Shading};
+pub use appearance::{
+    Appearance, Keep, Light, Lookup, MAX_CANDIDATES, MAX_OBJECTS, Mode, Object, ObjectTable, Segmentation, SelectionWeight, Shading,
+};
+pub use appearance_spec::{AppearanceSpec, LabelOverride, LabelsSpec, ObjectSpec, SegmentationSpec};
 pub use camera::{Camera, Orbit, Projection, Ray, View};
 pub use scene::RenderScene;
 
@@ -154,14 +158,6 @@ impl Region {
         }
     }
 
-    /// A dataset's region: its volume's box placed by `transform`, cut by its clipping
-    /// (one region per dataset; the volume and appearance share the index).
-    pub fn dataset(grid: &Grid, transform: Affine3A, clip: &crate::clip::Clipping, index: usize) -> Region {
-        let mut region = Region::volume_box_at(grid, transform, index, index);
-        region.planes.extend(clip.world_planes(&transform));
-        region
-    }
-
     /// The region cut to the continuous voxel-index box `[lo, hi]` of its volume;
     /// planes that no longer bound it are dropped (so the box's planes replace the
     /// volume's, not add to them).
@@ -195,6 +191,18 @@ impl Region {
         }
         out
     }
+}
+
+/// Whether convex regions share volume that no hole of theirs holds (the renderer's
+/// test of which regions a ray can be inside at once).
+pub fn meet(regions: &[&Region]) -> bool {
+    let all: Vec<Plane> = regions.iter().flat_map(|r| r.planes.iter().copied()).collect();
+    if !has_volume(&all) {
+        return false;
+    }
+    let corners = vertices(&all);
+    let holds = |hole: &[Plane; 6]| corners.iter().all(|p| hole.iter().all(|pl| pl.distance(*p) <= 1e-4 * (1.0 + p.length())));
+    !regions.iter().flat_map(|r| r.holes.iter()).any(holds)
 }
 
 /// `[a, b]` less the open interval `(c, d)`: none, one or two closed intervals (the

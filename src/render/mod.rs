@@ -24,10 +24,9 @@ pub mod lens_pack;
 pub mod pack;
 pub mod pass;
 pub mod pipeline;
+pub mod progress;
 pub mod shaders;
 pub mod upload;
-
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::prelude::*;
@@ -35,38 +34,15 @@ use bevy::render::extract_component::{ExtractComponentPlugin, UniformComponentPl
 use bevy::render::renderer::RenderDevice;
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 
-pub use extract::VolumeView;
 pub use gpu_types::GpuSettings;
+pub use progress::RenderProgress;
 
-use crate::dataset::SceneRegions;
 use crate::dataset::gpu_fit::{GpuLimits, fit_datasets};
+use crate::dataset::{SceneRegions, VolumeView};
+use progress::record_pipeline_state;
 
 /// The volume ray caster.
 pub struct VolumeRenderPlugin;
-
-/// Render progress shared by the main and render worlds: how many times the ray-cast
-/// pass has drawn volumes and whether every queued pipeline (ours, egui's, …) is built.
-/// The app's automation waits for both before it takes a screenshot.
-#[derive(Resource, Clone, Default)]
-pub struct RenderProgress(std::sync::Arc<(AtomicU64, AtomicBool)>);
-
-impl RenderProgress {
-    pub fn volumes_drawn(&self) -> u64 {
-        self.0.0.load(Ordering::Relaxed)
-    }
-
-    pub fn pipelines_settled(&self) -> bool {
-        self.0.1.load(Ordering::Relaxed)
-    }
-
-    pub(crate) fn count_draw(&self) {
-        self.0.0.fetch_add(1, Ordering::Relaxed);
-    }
-}
-
-fn record_pipeline_state(progress: Res<RenderProgress>, cache: Res<bevy::render::render_resource::PipelineCache>) {
-    progress.0.1.store(cache.waiting_pipelines().next().is_none(), Ordering::Relaxed);
-}
 
 impl Plugin for VolumeRenderPlugin {
     fn build(&self, app: &mut App) {

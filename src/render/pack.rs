@@ -19,81 +19,7 @@ use crate::volume::pyramid::{MIP_LEVELS, half_dims};
 use super::gpu_types::{CLUSTER, GpuRegion, context_power, mode, region_flags};
 use crate::context::Power;
 use crate::reference::prepare::{PreparedLookup, PreparedRegion};
-use crate::region::{Mode, RenderScene};
-
-/// Width of the lookup-table atlas in texels.
-pub const LUT_ATLAS_WIDTH: u32 = 4096;
-
-/// A scene in GPU layout.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct PackedScene {
-    pub regions: Vec<GpuRegion>,
-    /// Plane `(normal, offset)` per entry; regions index ranges of it.
-    pub planes: Vec<Vec4>,
-    /// RGBA texels, `LUT_ATLAS_WIDTH` per row, rows stacked.
-    pub lut: Vec<[f32; 4]>,
-    /// Occupancy bits (bit `i % 32` of word `i / 32` is brick `i`).
-    pub occupancy: Vec<u32>,
-    /// Scene volume indices placed in the atlases, in atlas order.
-    pub volumes: Vec<usize>,
-    /// The boxes of the volume atlas: each of `volumes`, followed by its mip levels
-    /// when `mips`.
-    pub atlas: Atlas,
-    /// The atlas holds the mip chains too (it does when they fit).
-    pub mips: bool,
-    /// Atlas offsets of each of `volumes`: the volume, then its mip levels.
-    pub levels: Vec<Vec<UVec3>>,
-    /// Where each of `volumes`' brick grids lies in the brick atlas.
-    pub brick_atlas: Atlas,
-    /// Regions left out, with the reason (the atlas is full).
-    pub dropped: Vec<String>,
-    /// Per entry of `volumes`: the scene volume whose codes fill the second channel of
-    /// its texels (a selection's degree of interest, [`doi_channels`]).
-    pub doi_channels: Vec<Option<usize>>,
-    /// Index in `regions` of every scene region (`None` for those dropped).
-    pub region_slots: Vec<Option<u32>>,
-    /// Regions the ray traverses: the first `region_count` of `regions` (the others
-    /// are records: the regions drawn in others' samples ([`companions`]), the parts and
-    /// labels of segmentations, the selections of weights).
-    pub region_count: u32,
-    /// Shader features the regions need ([`super::gpu_types::features`]).
-    pub features: u32,
-    /// Bound on the iterations of the ray caster's loops ([`march_bound`]).
-    pub max_steps: u32,
-}
-
-/// Boxes placed in a 3D texture.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Atlas {
-    pub size: UVec3,
-    pub offsets: Vec<UVec3>,
-}
-
-/// Shelf packing: boxes stacked along z in columns, columns side by side along x, each
-/// axis at most `max` texels. Returns `None` when they do not fit.
-pub fn atlas_layout(sizes: &[UVec3], max: u32) -> Option<Atlas> {
-    let mut offsets = Vec::with_capacity(sizes.len());
-    let (mut column_x, mut column_w, mut z) = (0u32, 0u32, 0u32);
-    let mut size = UVec3::ONE;
-    for &b in sizes {
-        if b.max_element() > max {
-            return None;
-        }
-        if z + b.z > max {
-            column_x += column_w;
-            column_w = 0;
-            z = 0;
-        }
-        if column_x + b.x > max {
-            return None;
-        }
-        offsets.push(UVec3::new(column_x, 0, z));
-        z += b.z;
-        column_w = column_w.max(b.x);
-        size = size.max(UVec3::new(column_x + b.x, b.y, z));
-    }
-    Some(Atlas { size, offsets })
-}
+use crate::region::{Mode, RenderScene, meet};
 
 /// Dimensions of a volume's boxes in the atlas: the volume, then (with `mips`) its levels.
 fn volume_boxes(dims: UVec3, mips: bool) -> Vec<UVec3> {
@@ -108,13 +34,6 @@ fn volume_boxes(dims: UVec3, mips: bool) -> Vec<UVec3> {
         }
     }
     boxes
-}
-
-impl PackedScene {
-    /// Rows of the LUT atlas.
-    pub fn lut_rows(&self) -> u32 {
-        (self.lut.len() as u32).div_ceil(LUT_ATLAS_WIDTH).max(1)
-    }
 }
 
 fn mode_number(m: Mode) -> u32 {
@@ -403,18 +322,6 @@ pub fn overlaps(prepared: &[&PreparedRegion]) -> Overlaps {
     out
 }
 
-/// Whether convex regions share volume that no hole of theirs holds (see [`overlaps`]).
-fn meet(regions: &[&crate::region::Region]) -> bool {
-    use crate::region::{Plane, has_volume, vertices};
-    let all: Vec<Plane> = regions.iter().flat_map(|r| r.planes.iter().copied()).collect();
-    if !has_volume(&all) {
-        return false;
-    }
-    let corners = vertices(&all);
-    let holds = |hole: &[Plane; 6]| corners.iter().all(|p| hole.iter().all(|pl| pl.distance(*p) <= 1e-4 * (1.0 + p.length())));
-    !regions.iter().flat_map(|r| r.holes.iter()).any(holds)
-}
-
 /// The shader features a list of regions needs, with their [`overlaps`].
 pub fn scene_features(regions: &[GpuRegion], overlaps: Overlaps) -> u32 {
     use super::gpu_types::features as f;
@@ -575,7 +482,9 @@ pub fn polyhedron_sphere(planes: &[crate::region::Plane]) -> Vec4 {
     center.extend(radius * (1.0 + 1e-4) + 1e-3)
 }
 
+mod packed;
 mod selection;
+pub use packed::{Atlas, LUT_ATLAS_WIDTH, PackedScene, atlas_layout};
 pub use selection::{companions, constant_bricks, doi_channels};
 use selection::{draw_in, pack_selection};
 

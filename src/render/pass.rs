@@ -30,7 +30,7 @@ pub fn raycast_pass(
     view_uniforms: Res<ViewUniforms>,
     settings: Res<ComponentUniforms<GpuSettings>>,
     scene: Res<GpuScene>,
-    progress: Res<super::RenderProgress>,
+    progress: Res<super::progress::RenderProgress>,
     mut ctx: RenderContext,
 ) {
     let (target, depth, view_offset, settings_index, pipeline_id, camera, fields) = view.into_inner();

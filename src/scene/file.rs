@@ -18,7 +18,6 @@
 //! ```
 //! Paths are relative to the scene file.
 
-use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use glam::Vec3;
@@ -27,7 +26,7 @@ use serde::{Deserialize, Serialize};
 use crate::clip::Clipping;
 use crate::context::ContextParams;
 
-use crate::region::{Light, Mode, Shading, View};
+use crate::region::{AppearanceSpec, Light, Mode, View};
 use crate::transfer::TransferFunction;
 use crate::volume::phantom::Phantom;
 
@@ -35,16 +34,12 @@ fn default_size() -> (u32, u32) {
     (512, 512)
 }
 
-fn default_step() -> f32 {
-    0.5
-}
-
-fn default_label_opacity() -> f32 {
-    0.6
-}
-
 fn default_resolution() -> u32 {
     256
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// A whole scene: data, appearance, camera and the frames to capture.
@@ -166,126 +161,6 @@ impl DatasetSpec {
 
 fn is_unclipped(c: &Clipping) -> bool {
     *c == Clipping::default()
-}
-
-/// How a dataset looks.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct AppearanceSpec {
-    #[serde(default)]
-    pub mode: Mode,
-    /// A built-in preset name or a `.ron` file (default: chosen for the data).
-    #[serde(default)]
-    pub preset: Option<String>,
-    /// An inline transfer function (wins over `preset`).
-    #[serde(default)]
-    pub transfer: Option<TransferFunction>,
-    /// Show the dataset as a label volume.
-    #[serde(default)]
-    pub labels: Option<LabelsSpec>,
-    #[serde(default)]
-    pub shading: Option<Shading>,
-    /// Sample distance in units of the smallest voxel spacing.
-    #[serde(default = "default_step")]
-    pub step: f32,
-    /// Iso-value in the data's units (default: middle of the value range).
-    #[serde(default)]
-    pub iso: Option<f64>,
-    /// κt, κs of the context-preserving mode.
-    #[serde(default)]
-    pub context: ContextParams,
-    /// Two-level rendering: objects from a label dataset, each with its own appearance;
-    /// this appearance draws the rest.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub segmentation: Option<SegmentationSpec>,
-}
-
-/// The objects of a segmented dataset ([`crate::twolevel`]).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SegmentationSpec {
-    /// Index in `datasets` of the label volume (it may be hidden; its grid places it).
-    pub labels: usize,
-    /// In order: a sample belongs to the first object that takes it.
-    pub objects: Vec<ObjectSpec>,
-    /// Whether samples in no object are drawn.
-    #[serde(default = "yes")]
-    pub rest_visible: bool,
-}
-
-/// One object of a segmentation.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ObjectSpec {
-    pub name: String,
-    /// Label codes it takes.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub labels: Vec<u32>,
-    /// Label names from the label dataset's table (a trailing `*` matches every name
-    /// with that prefix). With neither codes nor names the object takes every label.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub names: Vec<String>,
-    /// Range of data values (real units, inclusive) it takes.
-    #[serde(default)]
-    pub values: Option<(f64, f64)>,
-    #[serde(default = "yes")]
-    pub visible: bool,
-    /// Mode, transfer function, shading, iso-value, context parameters.
-    #[serde(default)]
-    pub appearance: AppearanceSpec,
-}
-
-fn yes() -> bool {
-    true
-}
-
-impl Default for AppearanceSpec {
-    fn default() -> Self {
-        Self {
-            mode: Mode::Dvr,
-            preset: None,
-            transfer: None,
-            labels: None,
-            shading: None,
-            step: 0.5,
-            iso: None,
-            context: ContextParams::default(),
-            segmentation: None,
-        }
-    }
-}
-
-/// Label-volume display: the table and per-label overrides.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct LabelsSpec {
-    /// Label table file (default: the sidecar files beside the volume).
-    #[serde(default)]
-    pub table: Option<PathBuf>,
-    /// Opacity of every label but the background.
-    #[serde(default = "default_label_opacity")]
-    pub opacity: f32,
-    /// Overrides by label id.
-    #[serde(default)]
-    pub styles: BTreeMap<u32, LabelOverride>,
-}
-
-impl Default for LabelsSpec {
-    fn default() -> Self {
-        Self { table: None, opacity: 0.6, styles: BTreeMap::new() }
-    }
-}
-
-/// A change to one label's style.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct LabelOverride {
-    #[serde(default)]
-    pub color: Option<(f32, f32, f32)>,
-    #[serde(default)]
-    pub opacity: Option<f32>,
-    #[serde(default)]
-    pub visible: Option<bool>,
 }
 
 /// The camera.

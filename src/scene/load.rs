@@ -5,12 +5,12 @@ use std::sync::Arc;
 
 use glam::{Affine3A, EulerRot, Quat, Vec3};
 
-use super::file::{AppearanceSpec, CameraSpec, Change, DatasetSpec, LabelsSpec, SceneFile, SegmentationSpec, SourceSpec, vec3};
+use super::file::{CameraSpec, Change, DatasetSpec, SceneFile, SourceSpec, vec3};
 use crate::clip::Clipping;
 use crate::dataset::Dataset;
-use crate::region::{Appearance, Camera, Lookup, Orbit, Projection, Region, RenderScene, View};
-use crate::transfer::{LabelTransfer, presets};
-use crate::twolevel::{Object, Segmentation};
+use crate::region::{Appearance, Camera, Lookup, Orbit, Projection, RenderScene, Segmentation, SegmentationSpec, View};
+use crate::transfer::presets;
+use crate::twolevel::spec::LabelSource;
 use crate::volume::phantom::head;
 use crate::volume::readers::{Progress, RawSpec, ReadOptions, label_table, read_volume};
 use crate::volume::{LabelTable, LabelVolume, Volume};
@@ -99,58 +99,17 @@ pub fn explosion(
         Some(LabelVolume { volume: (*ds.volume).clone(), table: ds.table.clone()? })
     };
     let selection = spec.selection(data, label)?;
-    let look = spec.look.as_ref().map(|l| appearance(l, data, None, base)).transpose().map_err(|e| format!("look: {e}"))?;
+    let look = spec.look.as_ref().map(|l| l.appearance(data, None, base)).transpose().map_err(|e| format!("look: {e}"))?;
     Ok(crate::explode::spec::LoadedExplode { exploded: spec.exploded(selection, look), parts: spec.parts(data)?, spec: spec.clone() })
 }
 
-/// The segmentation a spec describes for data volume `data`.
+/// The segmentation a spec describes for data volume `data`: its label volume is the
+/// scene's dataset `spec.labels`.
 pub fn segmentation(spec: &SegmentationSpec, datasets: &[LoadedDataset], data: &Volume, base: &Path) -> Result<Segmentation, String> {
     let n = datasets.len();
     let source = datasets.get(spec.labels).ok_or_else(|| format!("labels refers to dataset {}, the scene has {n}", spec.labels))?;
-    let objects = spec
-        .objects
-        .iter()
-        .map(|o| {
-            let mut labels = o.labels.clone();
-            for pattern in &o.names {
-                let found = matching_labels(pattern, source.table.as_ref());
-                if found.is_empty() {
-                    return Err(format!("object '{}': no label of '{}' is named '{pattern}'", o.name, source.name));
-                }
-                labels.extend(found);
-            }
-            labels.sort_unstable();
-            labels.dedup();
-            if o.appearance.segmentation.is_some() {
-                return Err(format!("object '{}': an object cannot be segmented again", o.name));
-            }
-            Ok(Object {
-                name: o.name.clone(),
-                labels,
-                values: o.values,
-                visible: o.visible,
-                appearance: appearance(&o.appearance, data, None, base).map_err(|e| format!("object '{}': {e}", o.name))?,
-            })
-        })
-        .collect::<Result<Vec<_>, String>>()?;
-    let seg =
-        Segmentation { table: source.table.clone().map(Arc::new), labels: source.volume.clone(), objects, rest_visible: spec.rest_visible };
-    seg.validate()?;
-    Ok(seg)
-}
-
-/// Ids of the labels named `pattern` (a trailing `*` matches a prefix; case-insensitive).
-pub fn matching_labels(pattern: &str, table: Option<&LabelTable>) -> Vec<u32> {
-    let Some(table) = table else { return Vec::new() };
-    let p = pattern.to_ascii_lowercase();
-    let matches = |name: &str| {
-        let name = name.to_ascii_lowercase();
-        match p.strip_suffix('*') {
-            Some(prefix) => name.starts_with(prefix),
-            None => name == p,
-        }
-    };
-    table.labels.iter().filter(|(_, l)| matches(&l.name)).map(|(id, _)| *id).collect()
+    let labels = LabelSource { name: &source.name, volume: &source.volume, table: source.table.as_ref() };
+    crate::twolevel::spec::segmentation(spec, labels, data, base)
 }
 
 fn load_dataset(spec: &DatasetSpec, base: &Path, options: &ReadOptions) -> Result<LoadedDataset, String> {
@@ -159,7 +118,7 @@ fn load_dataset(spec: &DatasetSpec, base: &Path, options: &ReadOptions) -> Resul
         SourceSpec::PhantomLabels { resolution } => {
             let h = head::generate(*resolution)?;
             let table = h.labels.table.clone();
-            let app = appearance(&spec.appearance, &h.labels.volume, Some(&table), base)?;
+            let app = spec.appearance.appearance(&h.labels.volume, Some(&table), base)?;
             return dataset(spec, h.labels.volume, app, Some(table));
         }
         SourceSpec::File(p) => {
@@ -180,11 +139,11 @@ fn load_dataset(spec: &DatasetSpec, base: &Path, options: &ReadOptions) -> Resul
                 (None, None) => LabelTable::default(),
             };
             let lv = LabelVolume::from_volume(volume, table)?;
-            let app = appearance(&spec.appearance, &lv.volume, Some(&lv.table), base)?;
+            let app = spec.appearance.appearance(&lv.volume, Some(&lv.table), base)?;
             dataset(spec, lv.volume, app, Some(lv.table))
         }
         None => {
-            let app = appearance(&spec.appearance, &volume, None, base)?;
+            let app = spec.appearance.appearance(&volume, None, base)?;
             dataset(spec, volume, app, None)
         }
     }
@@ -204,56 +163,6 @@ fn dataset(spec: &DatasetSpec, volume: Volume, appearance: Appearance, table: Op
         spec: spec.clone(),
         explode: None,
     })
-}
-
-/// Label styles from the table, with the spec's opacity and overrides.
-pub fn label_styles(labels: &LabelsSpec, volume: &Volume, table: &LabelTable) -> LabelTransfer {
-    let ids = crate::volume::stats::code_counts(&volume.voxels).into_iter().enumerate().filter(|(_, c)| *c > 0).map(|(id, _)| id as u32);
-    let mut styles = LabelTransfer::from_table(table, ids, labels.opacity);
-    for (id, o) in &labels.styles {
-        let s = styles.styles.entry(*id).or_insert(crate::transfer::LabelStyle { color: [1.0; 3], opacity: labels.opacity, visible: true });
-        if let Some((r, g, b)) = o.color {
-            s.color = [r, g, b];
-        }
-        if let Some(a) = o.opacity {
-            s.opacity = a;
-        }
-        if let Some(v) = o.visible {
-            s.visible = v;
-        }
-    }
-    styles
-}
-
-/// The appearance a spec describes for `volume`.
-pub fn appearance(spec: &AppearanceSpec, volume: &Volume, table: Option<&LabelTable>, base: &Path) -> Result<Appearance, String> {
-    let lookup = match (&spec.labels, table) {
-        (Some(labels), Some(table)) => Lookup::Labels(label_styles(labels, volume, table)),
-        _ => Lookup::Transfer(match (&spec.transfer, &spec.preset) {
-            (Some(tf), _) => tf.clone().validated()?,
-            (None, Some(p)) => presets::load(&preset_path(p, base))?,
-            (None, None) if spec.mode.is_projection() => presets::builtin("grayscale_ramp")?,
-            (None, None) => presets::default_for(volume)?,
-        }),
-    };
-    if !(0.01..=16.0).contains(&spec.step) {
-        return Err(format!("step {} is outside 0.01..16 voxels", spec.step));
-    }
-    Ok(Appearance {
-        mode: spec.mode,
-        lookup,
-        shading: spec.shading.unwrap_or_default(),
-        step: spec.step,
-        iso_value: spec.iso.unwrap_or((volume.stats.min + volume.stats.max) * 0.5),
-        context: spec.context.validated()?,
-        segmentation: None,
-        selection: None,
-    })
-}
-
-/// A preset key, or a `.ron` path resolved against the scene folder.
-fn preset_path(p: &str, base: &Path) -> String {
-    if p.ends_with(".ron") { resolve(base, Path::new(p)).display().to_string() } else { p.to_string() }
 }
 
 /// World bounds of what the visible datasets show (union; their boxes if nothing shows).
@@ -317,7 +226,7 @@ pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneF
     match change {
         Change::Mode { dataset, mode } => datasets[get(*dataset)?].appearance.mode = *mode,
         Change::Preset { dataset, preset } => {
-            datasets[get(*dataset)?].appearance.lookup = Lookup::Transfer(presets::load(&preset_path(preset, base))?)
+            datasets[get(*dataset)?].appearance.lookup = Lookup::Transfer(presets::load_relative(preset, base)?)
         }
         Change::Transfer { dataset, transfer } => {
             datasets[get(*dataset)?].appearance.lookup = Lookup::Transfer(transfer.clone().validated()?)
@@ -387,7 +296,7 @@ pub fn render_scene(datasets: &[LoadedDataset], scene: &SceneFile) -> RenderScen
     };
     for d in datasets.iter().filter(|d| d.visible) {
         let i = out.volumes.len();
-        out.regions.push(Region::dataset(&d.volume.grid, d.transform, &d.clip, i));
+        out.regions.push(d.clip.region(&d.volume.grid, d.transform, i));
         out.volumes.push(d.volume.clone());
         out.appearances.push(d.appearance.clone());
     }
@@ -407,7 +316,7 @@ pub fn window_appearances(scene: &SceneFile, datasets: &[LoadedDataset], base: &
                     let d = datasets.get(c.dataset).ok_or_else(|| format!("window {i}: content refers to dataset {}", c.dataset))?;
                     c.appearance
                         .as_ref()
-                        .map(|a| appearance(a, &d.volume, d.table.as_ref(), base).map_err(|e| format!("window {i}: {e}")))
+                        .map(|a| a.appearance(&d.volume, d.table.as_ref(), base).map_err(|e| format!("window {i}: {e}")))
                         .transpose()
                 })
                 .collect()

@@ -8,10 +8,10 @@ use bevy::prelude::*;
 use super::file::{FrameSpec, SceneFile};
 use super::load::{LoadedDataset, apply, camera, load_datasets, read_scene, render_scene_with_windows, visible_bounds, window_appearances};
 use crate::FocalPlugins;
+use crate::dataset::VolumeView;
 use crate::dataset::{Dataset, SceneLight};
 use crate::lens::systems::replace_lenses;
 use crate::reference::render_lensed;
-use crate::render::VolumeView;
 use crate::render::headless::Offscreen;
 use crate::windows::spec::{replace_markers, replace_windows};
 

@@ -7,12 +7,10 @@ use std::path::Path;
 
 use glam::{EulerRot, Quat, Vec3};
 
-use super::file::{
-    AppearanceSpec, CameraSpec, DatasetSpec, LabelOverride, LabelsSpec, ObjectSpec, SceneFile, SegmentationSpec, SourceSpec,
-};
+use super::file::{CameraSpec, DatasetSpec, SceneFile, SourceSpec};
 use super::load::resolve;
-use crate::region::{Appearance, Camera, Light, Lookup, Projection};
-use crate::twolevel::Segmentation;
+use crate::region::{Appearance, AppearanceSpec, Camera, Light, Projection};
+use crate::twolevel::spec::segmentation_spec;
 
 /// One dataset as the app holds it.
 pub struct DatasetState<'a> {
@@ -40,60 +38,6 @@ impl<'a> DatasetState<'a> {
             explode: d.spec.explode.clone(),
         }
     }
-}
-
-/// The appearance as a spec.
-pub fn appearance_spec(a: &Appearance, labels_table: Option<&LabelsSpec>) -> AppearanceSpec {
-    let (transfer, labels) = match &a.lookup {
-        Lookup::Transfer(tf) => (Some(tf.clone()), None),
-        Lookup::Labels(styles) => {
-            let base = labels_table.cloned().unwrap_or_default();
-            let styles = styles
-                .styles
-                .iter()
-                .map(|(id, s)| {
-                    (
-                        *id,
-                        LabelOverride {
-                            color: Some((s.color[0], s.color[1], s.color[2])),
-                            opacity: Some(s.opacity),
-                            visible: Some(s.visible),
-                        },
-                    )
-                })
-                .collect();
-            (None, Some(LabelsSpec { styles, ..base }))
-        }
-    };
-    AppearanceSpec {
-        mode: a.mode,
-        preset: None,
-        transfer,
-        labels,
-        shading: Some(a.shading),
-        step: a.step,
-        iso: Some(a.iso_value),
-        context: a.context,
-        segmentation: None,
-    }
-}
-
-/// A segmentation as a spec (objects by label code); `labels` is the label dataset's
-/// index.
-pub fn segmentation_spec(seg: &Segmentation, labels: usize) -> SegmentationSpec {
-    let objects = seg
-        .objects
-        .iter()
-        .map(|o| ObjectSpec {
-            name: o.name.clone(),
-            labels: o.labels.clone(),
-            names: Vec::new(),
-            values: o.values,
-            visible: o.visible,
-            appearance: appearance_spec(&o.appearance, None),
-        })
-        .collect();
-    SegmentationSpec { labels, objects, rest_visible: seg.rest_visible }
 }
 
 /// Source paths made absolute (the saved file may live elsewhere).
@@ -130,7 +74,7 @@ pub fn scene_file(
                         .as_ref()
                         .zip(d.spec.appearance.segmentation.as_ref())
                         .map(|(seg, spec)| segmentation_spec(seg, spec.labels)),
-                    ..appearance_spec(d.appearance, d.spec.appearance.labels.as_ref())
+                    ..AppearanceSpec::of(d.appearance, d.spec.appearance.labels.as_ref())
                 },
                 translation: d.translation.into(),
                 rotation_deg: (x.to_degrees(), y.to_degrees(), z.to_degrees()),

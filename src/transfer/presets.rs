@@ -50,6 +50,11 @@ pub fn load(key_or_path: &str) -> Result<TransferFunction, String> {
     builtin(key_or_path)
 }
 
+/// Like [`load`], with a `.ron` path taken relative to `base` (a scene file's folder).
+pub fn load_relative(key_or_path: &str, base: &Path) -> Result<TransferFunction, String> {
+    if key_or_path.ends_with(".ron") { load(&base.join(key_or_path).display().to_string()) } else { load(key_or_path) }
+}
+
 /// The preset a medical viewer would open a volume with: skin and bone for CT (values
 /// in Hounsfield units), the MR default otherwise.
 pub fn default_for(volume: &Volume) -> Result<TransferFunction, String> {

@@ -23,10 +23,17 @@
 //! Samples in no object belong to *the rest*, rendered with the data volume's own
 //! appearance (typically a faint or context-preserving view of everything else).
 //!
-//! [`model`] holds the description ([`Segmentation`], [`Object`]) and the pure object
-//! lookup both renderers use; the CPU reference ([`crate::reference::trace`]) and the
-//! shader (`shaders/raycast.wgsl`, `two_level_sample`) implement the compositing.
+//! The description ([`Segmentation`], [`Object`]) and the pure object lookup both
+//! renderers use ([`ObjectTable`]) are part of a region's look, in
+//! [`crate::region::appearance`] (an object's look is an appearance again, so the two
+//! cannot live apart). This folder holds what is two-level rendering's alone: [`spec`],
+//! how scene files name objects (label codes, names matched in the label table, value
+//! ranges) and how they are resolved against the label volume. The CPU reference
+//! ([`crate::reference::trace`]) and the shader (`shaders/focal/two_level.wgsl`)
+//! implement the compositing.
+//!
+//! [`Segmentation`]: crate::region::Segmentation
+//! [`Object`]: crate::region::Object
+//! [`ObjectTable`]: crate::region::ObjectTable
 
-pub mod model;
-
-pub use model::{MAX_CANDIDATES, MAX_OBJECTS, Object, ObjectTable, Segmentation};
+pub mod spec;

@@ -7,9 +7,9 @@ use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use bevy_egui::egui::{self, Color32, Rect, Stroke, pos2};
 
-use super::lenses::viewport_logical;
 use super::orbit::{OrbitCamera, PointerInViewport};
-use super::{AppState, MainCamera};
+use super::state::{AppState, MainCamera};
+use super::viewport::viewport_logical;
 use crate::clip::gizmo::{box_section, drag_along_normal};
 use crate::dataset::Dataset;
 

@@ -8,10 +8,10 @@ use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use bevy_egui::{EguiContexts, egui};
 
-use super::explode_panel::{ExplodeUi, Tool};
-use super::lenses::viewport_logical;
+use super::explode_tools::{ExplodeUi, Tool};
 use super::orbit::{OrbitCamera, PointerInViewport};
-use super::{AppState, MainCamera};
+use super::state::{AppState, MainCamera};
+use super::viewport::viewport_logical;
 use crate::dataset::{Dataset, SceneRegions};
 use crate::explode::edit::{background_hit, nearest_part};
 use crate::explode::splitters::{axis_plane, depth_plane, in_part_frame};

@@ -6,10 +6,10 @@
 use bevy::prelude::*;
 use bevy_egui::egui;
 
-use super::explode_panel::{ExplodeUi, Tool};
+use super::explode_tools::{ExplodeUi, Tool};
 use super::orbit::OrbitCamera;
-use crate::explode::components::ExplodeSource;
 use crate::explode::edit::{Edit, ExplodeEdits};
+use crate::explode::spec::ExplodeSource;
 
 /// Most binomial smoothing passes the panel offers.
 const MAX_SMOOTHING: u32 = 6;

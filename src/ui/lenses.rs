@@ -14,8 +14,9 @@ use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use bevy_egui::egui::{self, Color32, Pos2, Rect, RichText, Sense, Stroke, pos2, vec2};
 
-use super::MainCamera;
 use super::orbit::{PointerInViewport, wheel_lines};
+use super::state::MainCamera;
+use super::viewport::viewport_logical;
 use crate::dataset::SceneRegions;
 use crate::lens::handles::{self, Handle};
 use crate::lens::lattice::{lattice, round_spacing};
@@ -103,15 +104,6 @@ impl LensParams<'_, '_> {
         let name = Name::new(format!("lens {}", lens.kind_name()));
         let e = self.commands.spawn((lens, LensOrder(top), name)).id();
         self.ui.selected = Some(e);
-    }
-}
-
-/// Window-logical origin and size of the main camera's viewport.
-pub fn viewport_logical(camera: &Camera, window: &Window) -> (Vec2, Vec2) {
-    let scale = window.scale_factor();
-    match &camera.viewport {
-        Some(v) => (v.physical_position.as_vec2() / scale, v.physical_size.as_vec2() / scale),
-        None => (Vec2::ZERO, Vec2::new(window.width(), window.height())),
     }
 }
 

@@ -14,7 +14,8 @@ use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
 use crate::dataset::{Dataset, SceneLight};
 use crate::lens::Lens;
 use crate::lens::systems::LensOrder;
-use crate::scene::file::{AppearanceSpec, DatasetSpec, SceneFile, SourceSpec};
+use crate::region::AppearanceSpec;
+use crate::scene::file::{DatasetSpec, SceneFile, SourceSpec};
 use crate::scene::load::{LoadedDataset, load_datasets_with, read_scene, visible_bounds};
 use crate::volume::readers::Progress;
 

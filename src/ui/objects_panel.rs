@@ -11,8 +11,8 @@ use std::sync::Arc;
 use bevy_egui::egui::{self, Color32, RichText, Ui};
 
 use crate::region::{Appearance, Mode};
+use crate::region::{Object, Segmentation};
 use crate::transfer::presets;
-use crate::twolevel::{Object, Segmentation};
 use crate::volume::{LabelTable, Volume};
 
 /// A loaded label volume that can segment others.

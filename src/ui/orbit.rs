@@ -260,6 +260,12 @@ pub fn double_click(buttons: &ButtonInput<MouseButton>, window: &Window, now: f6
 /// The primary window (for cursor positions).
 pub type PrimaryWindowQuery<'w, 's> = Query<'w, 's, &'static Window, With<PrimaryWindow>>;
 
+/// Turns fly-through on or off; its speed follows the scene's size.
+pub fn toggle_fly(orbit: &mut OrbitCamera, bounds: (Vec3, Vec3)) {
+    orbit.fly = !orbit.fly;
+    orbit.fly_speed = ((bounds.1 - bounds.0).length() * 0.25).max(1e-3);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -9,7 +9,9 @@ use bevy_egui::{EguiContexts, egui::Ui};
 
 use super::loading::{DatasetOrigin, LoadRequest, Loading, Session};
 use super::orbit::{OrbitCamera, PointerInViewport};
-use super::{AppState, DialogPurpose, MainCamera, SHORTCUTS, lenses, objects_panel, scene_bounds, set_viewport, tf_editor};
+use super::state::{AppState, DialogPurpose, MainCamera, SHORTCUTS, default_scene, scene_bounds};
+use super::viewport::set_viewport;
+use super::{lenses, objects_panel, tf_editor};
 use crate::context::{ContextParams, Power};
 use crate::dataset::{Dataset, GpuVolume, SceneLight, SceneRegions};
 use crate::region::{Light, Lookup, Mode, View};
@@ -106,7 +108,7 @@ pub fn ui(
                     state.dialog.save_file();
                 }
                 if ui.button("Head phantom").clicked() {
-                    load.write(LoadRequest::Scene(super::default_scene(), Default::default()));
+                    load.write(LoadRequest::Scene(default_scene(), Default::default()));
                 }
             });
             ui.menu_button("View", |ui| {
@@ -471,7 +473,7 @@ fn camera_panel(ui: &mut Ui, orbit: &mut OrbitCamera, bounds: (Vec3, Vec3)) {
         ui.checkbox(&mut orbit.orthographic, "orthographic");
         let mut fly = orbit.fly;
         if ui.checkbox(&mut fly, "fly-through (V)").changed() {
-            super::toggle_fly(orbit, bounds);
+            super::orbit::toggle_fly(orbit, bounds);
         }
     });
     ui.add(egui::Slider::new(&mut orbit.fov_deg, 10.0..=90.0).text("field of view °"));

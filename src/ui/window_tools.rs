@@ -15,9 +15,9 @@ use bevy::window::PrimaryWindow;
 use bevy_egui::EguiContexts;
 use bevy_egui::egui::{self, Color32, Stroke};
 
-use super::MainCamera;
-use super::lenses::viewport_logical;
 use super::orbit::{OrbitCamera, PointerInViewport, wheel_lines};
+use super::state::MainCamera;
+use super::viewport::viewport_logical;
 use crate::dataset::{Dataset, SceneRegions};
 use crate::region::Ray;
 use crate::windows::boxes::OrientedBox;

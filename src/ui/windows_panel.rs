@@ -7,8 +7,8 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy_egui::egui::{self, RichText, Ui};
 
-use super::MainCamera;
 use super::orbit::OrbitCamera;
+use super::state::MainCamera;
 use crate::dataset::Dataset;
 use crate::region::Appearance;
 use crate::windows::markers::Marker;

@@ -147,7 +147,12 @@ impl Volume {
     /// Largest central-difference gradient magnitude in normalised units per voxel,
     /// the denominator of normalised gradient magnitude (computed on first use).
     pub fn gradient_max(&self) -> f32 {
-        *self.gradient_max.get_or_init(|| sample::max_gradient_magnitude(self))
+        *self.gradient_max.get_or_init(|| sample::max_gradient_magnitude(&self.voxels, self.grid.dims))
+    }
+
+    /// A sampler of its voxel codes (trilinear, nearest, gradients).
+    pub fn sampler(&self) -> sample::VolumeSampler<'_> {
+        sample::VolumeSampler::new(&self.voxels, self.grid.dims)
     }
 
     /// Approximate memory used by the voxels.

@@ -12,7 +12,7 @@
 use glam::{UVec3, Vec3};
 use rayon::prelude::*;
 
-use super::{Volume, Voxels};
+use super::Voxels;
 
 /// A voxel code type.
 pub trait Code: Copy + Send + Sync + 'static {
@@ -120,10 +120,6 @@ impl<'a> VolumeSampler<'a> {
         }
     }
 
-    pub fn of(volume: &'a Volume) -> Self {
-        Self::new(&volume.voxels, volume.grid.dims)
-    }
-
     #[inline]
     pub fn trilinear(&self, p: Vec3) -> f32 {
         match self {
@@ -149,10 +145,10 @@ impl<'a> VolumeSampler<'a> {
     }
 }
 
-/// Largest gradient magnitude over all voxel centres (normalised units per voxel).
-pub fn max_gradient_magnitude(volume: &Volume) -> f32 {
-    let dims = volume.grid.dims;
-    let sampler = VolumeSampler::of(volume);
+/// Largest gradient magnitude over all voxel centres of `voxels` on a `dims` grid
+/// (normalised units per voxel).
+pub fn max_gradient_magnitude(voxels: &Voxels, dims: UVec3) -> f32 {
+    let sampler = VolumeSampler::new(voxels, dims);
     (0..dims.z)
         .into_par_iter()
         .map(|z| {

@@ -10,7 +10,6 @@ use std::collections::BTreeSet;
 
 use rayon::prelude::*;
 
-use super::sample::VolumeSampler;
 use super::{Grid, LabelVolume, Source, ValueMap, Volume, Voxels};
 
 /// Degree-of-interest volume.
@@ -66,7 +65,7 @@ impl SelectionVolume {
         }
         grid.validate()?;
         let to_index = self.volume.grid.world_to_index() * grid.index_to_world();
-        let sampler = VolumeSampler::of(&self.volume);
+        let sampler = self.volume.sampler();
         let (lo, hi) = (glam::Vec3::splat(-0.5), self.volume.dims().as_vec3() - 0.5);
         let d = grid.dims;
         let m = to_index.matrix3;

@@ -15,7 +15,7 @@ use super::components::{Attachment, Automation, Content, Fit, Orientation, Point
 use super::mapping::{coupled_rotation, map_rotation};
 use super::markers::Marker;
 use super::regions::{PlacedContent, PlacedWindow};
-use crate::region::Appearance;
+use crate::region::{Appearance, AppearanceSpec};
 
 /// A window of a scene file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -45,7 +45,7 @@ pub struct WindowSpec {
 pub struct ContentSpec {
     pub dataset: usize,
     #[serde(default)]
-    pub appearance: Option<crate::scene::file::AppearanceSpec>,
+    pub appearance: Option<AppearanceSpec>,
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -300,7 +300,7 @@ pub fn window_spec(
             .iter()
             .filter_map(|c| {
                 let dataset = dataset_index(c.dataset)?;
-                Some(ContentSpec { dataset, appearance: c.appearance.as_ref().map(|a| crate::scene::save::appearance_spec(a, None)) })
+                Some(ContentSpec { dataset, appearance: c.appearance.as_ref().map(|a| AppearanceSpec::of(a, None)) })
             })
             .collect(),
         source,

@@ -6,9 +6,9 @@ use std::sync::Arc;
 
 use bevy::prelude::*;
 use focal::dataset::Dataset;
-use focal::explode::components::ExplodeSource;
 use focal::explode::edit::{Edit, Splitter, apply, current_spec};
 use focal::explode::paint::Brush;
+use focal::explode::spec::ExplodeSource;
 use focal::explode::spec::ExplodeSpec;
 use focal::explode::splitters::ScreenAxis;
 use focal::explode::{Exploded, ExplosionPoints, Part};

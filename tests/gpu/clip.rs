@@ -4,7 +4,6 @@
 
 use super::*;
 use focal::clip::{ClipBox, ClipPlane, Clipping};
-use focal::region::Region;
 
 pub fn clipping_matches_the_reference(gpu: &mut Gpu) {
     let engine = Arc::new(Phantom::Engine.generate(64).unwrap());
@@ -23,7 +22,7 @@ pub fn clipping_matches_the_reference(gpu: &mut Gpu) {
     dataset.clip = clip.clone();
     let g = gpu.show_dataset(dataset, transform, &cam);
     let mut scene = RenderScene::single(engine.clone(), a.clone());
-    scene.regions[0] = Region::dataset(&engine.grid, transform.compute_affine(), &clip, 0);
+    scene.regions[0] = clip.region(&engine.grid, transform.compute_affine(), 0);
     let c = render(&scene, &cam, SIZE, SIZE).unwrap().to_image().unwrap();
     assert_matches("clipped_engine", &g, &c);
     // And clipping removed something: the unclipped picture differs.

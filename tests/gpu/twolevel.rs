@@ -5,7 +5,7 @@
 
 use super::*;
 use focal::region::Region;
-use focal::twolevel::{Object, Segmentation};
+use focal::region::{Object, Segmentation};
 use focal::volume::phantom::head::label;
 
 fn segmented_head() -> (Arc<Volume>, Appearance) {

@@ -27,7 +27,7 @@ use focal::transfer::presets;
 use focal::volume::SelectionVolume;
 use focal::volume::phantom::head;
 
-use super::{Bench, Row, difference, push_group};
+use super::harness::{Bench, Row, difference, push_group};
 
 /// The grids of 1, 2, 4, …, 64 parts.
 const GRIDS: [(u32, u32, u32); 7] = [(1, 1, 1), (2, 1, 1), (2, 2, 1), (2, 2, 2), (4, 2, 2), (4, 4, 2), (4, 4, 4)];

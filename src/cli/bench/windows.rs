@@ -32,7 +32,7 @@ use focal::transfer::presets;
 use focal::volume::phantom::Phantom;
 use focal::windows::{Automation, Content, Fit, Orientation, Pointer3d, Source, SourceBox, VolumeWindow};
 
-use super::{Bench, Row, difference, push_group};
+use super::harness::{Bench, Row, difference, push_group};
 
 /// Entities a configuration adds (removed before the next one).
 #[derive(Component)]

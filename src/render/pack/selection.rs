@@ -5,8 +5,11 @@
 
 use glam::Mat4;
 
-use super::{GpuRegion, PackedScene, PreparedLookup, PreparedRegion, meet, mode, region_flags};
+use super::packed::PackedScene;
+use crate::reference::prepare::{PreparedLookup, PreparedRegion};
 use crate::region::Mode;
+use crate::region::meet;
+use crate::render::gpu_types::{GpuRegion, mode, region_flags};
 
 /// Per scene volume (`all`), the selection volume whose degree of interest can ride in
 /// the second channel of its texels, so that one texture fetch gives a sample's value

@@ -9,7 +9,7 @@
 //!   Format:         UCHAR
 //!   ```
 //!   `Format` is `UCHAR`, `USHORT`, `SHORT`, `FLOAT` (and the other type names of
-//!   [`super::raw::parse_sample_type`]); data is little-endian.
+//!   [`super::common::parse_sample_type`]); data is little-endian.
 //! - **Binary** (TU Wien): three little-endian `u16` dimensions followed by `u16` voxels
 //!   (12-bit CT values), recognised when the file size is exactly `6 + 2·x·y·z`.
 
@@ -18,8 +18,7 @@ use std::path::Path;
 
 use glam::{UVec3, Vec3};
 
-use super::common::{Problem, ReadError, ReadOptions, file_len, open, parse_n, read_text};
-use super::raw::{RawSpec, parse_sample_type, read_as};
+use super::common::{Problem, RawSpec, ReadError, ReadOptions, file_len, open, parse_n, parse_sample_type, read_raw, read_text};
 use crate::volume::Volume;
 use crate::volume::encode::{ByteOrder, SampleType};
 
@@ -38,7 +37,7 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
             spacing: Vec3::ONE,
             skip: 6,
         };
-        return read_as(path, &spec, options, "TU Wien .dat", vec![("layout".into(), "binary header: 3 × u16 dimensions".into())]);
+        return read_raw(path, &spec, options, "TU Wien .dat", vec![("layout".into(), "binary header: 3 × u16 dimensions".into())]);
     }
     let text = read_text(path, 1 << 16)?;
     let spec = parse_text(&text).map_err(fail)?;
@@ -47,7 +46,7 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
     if !raw.is_file() {
         return Err(fail(Problem::Malformed(format!("ObjectFileName '{}' not found beside the .dat file", file.trim()))));
     }
-    read_as(&raw, &spec, options, "volvis .dat + raw", vec![("header".into(), path.display().to_string())])
+    read_raw(&raw, &spec, options, "volvis .dat + raw", vec![("header".into(), path.display().to_string())])
 }
 
 /// Parses the text convention into the raw file name and its layout.

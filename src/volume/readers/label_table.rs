@@ -9,8 +9,7 @@
 
 use std::path::Path;
 
-use super::common::{Problem, ReadError, file_len, read_text};
-use super::sidecars;
+use super::common::{Problem, ReadError, file_len, read_text, sidecars};
 use crate::volume::{Label, LabelTable, labels::generated_color};
 
 /// Reads a label table file of any supported kind.

@@ -19,10 +19,9 @@ pub mod vti;
 
 use std::fs::File;
 use std::io::Read;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-pub use common::{Problem, Progress, ReadError, ReadOptions};
-pub use raw::RawSpec;
+pub use common::{Problem, Progress, RawSpec, ReadError, ReadOptions, sidecars};
 
 use super::{LabelVolume, Volume};
 
@@ -146,29 +145,4 @@ pub fn read_label_volume(path: &Path, table: Option<&Path>, options: &ReadOption
         None => label_table::read_sidecars(path)?,
     };
     LabelVolume::from_volume(volume, table).map_err(|e| ReadError::new(path, Problem::Values(e)))
-}
-
-/// Sidecar candidates of a volume path: the name with its volume extension stripped
-/// and each of `exts` appended, plus the full name with `exts` appended (`aal.nii.txt`).
-pub fn sidecars(path: &Path, exts: &[&str]) -> Vec<PathBuf> {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let mut stems = vec![name.clone()];
-    for ext in [".nii.gz", ".gz", ".nii", ".nrrd", ".nhdr", ".mha", ".mhd", ".vti"] {
-        if let Some(s) = name.strip_suffix(ext) {
-            stems.push(s.to_string());
-            if let Some(s2) = s.strip_suffix(".nii") {
-                stems.push(format!("{s2}.nii"));
-            }
-        }
-    }
-    let mut out = Vec::new();
-    for stem in stems {
-        for ext in exts {
-            let p = path.with_file_name(format!("{stem}.{ext}"));
-            if !out.contains(&p) {
-                out.push(p);
-            }
-        }
-    }
-    out
 }

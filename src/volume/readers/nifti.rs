@@ -20,7 +20,9 @@ use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Vec3};
 
-use super::common::{Compression, Problem, ReadError, ReadOptions, decoder, encode, file_len, open_buffered, read_exact_bounded, skip};
+use super::common::{
+    Compression, Problem, ReadError, ReadOptions, decoder, encode, file_len, open_buffered, read_exact_bounded, skip, volume_name,
+};
 use crate::volume::encode::{ByteOrder, SampleType};
 use crate::volume::{Grid, Source, Volume};
 
@@ -155,12 +157,6 @@ fn image_path(path: &Path) -> Option<PathBuf> {
     let lower = s.to_ascii_lowercase();
     let stem = [".hdr.gz", ".hdr", ".img.gz", ".img"].iter().find(|e| lower.ends_with(*e)).map(|e| &s[..s.len() - e.len()])?;
     [".img", ".img.gz"].iter().map(|e| PathBuf::from(format!("{stem}{e}"))).find(|p| p.exists())
-}
-
-/// Name shown for a volume: the file name without its extensions.
-pub fn volume_name(path: &Path) -> String {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "volume".into());
-    name.split('.').next().filter(|s| !s.is_empty()).unwrap_or(&name).to_string()
 }
 
 /// Parses a NIfTI-1 or NIfTI-2 header from its first bytes.

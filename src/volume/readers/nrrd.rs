@@ -16,9 +16,8 @@ use glam::{Mat3, Vec3};
 
 use super::common::{
     Compression, Problem, ReadError, ReadOptions, decoder, encode, file_len, finite, first_component, open, open_buffered, parse_n,
-    parse_numbers, pattern_files, read_exact_bounded, skip,
+    parse_numbers, pattern_files, read_exact_bounded, skip, volume_name,
 };
-use super::nifti::volume_name;
 use crate::volume::encode::{ByteOrder, SampleType, encode_values};
 use crate::volume::{Grid, Source, Volume};
 

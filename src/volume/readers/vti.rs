@@ -19,8 +19,9 @@ use quick_xml::Reader;
 use quick_xml::events::{BytesStart, Event};
 use rayon::prelude::*;
 
-use super::common::{Problem, ReadError, ReadOptions, encode, file_len, first_component, inflate_zlib, parse_n, parse_numbers};
-use super::nifti::volume_name;
+use super::common::{
+    Problem, ReadError, ReadOptions, encode, file_len, first_component, inflate_zlib, parse_n, parse_numbers, volume_name,
+};
 use crate::volume::encode::{ByteOrder, SampleType, encode_values};
 use crate::volume::{Grid, Source, Volume};
 

@@ -17,20 +17,17 @@
 //! - Compressed transfer syntaxes (JPEG, JPEG-LS lossless, RLE, …) are decoded by
 //!   `dicom-pixeldata`; a decoder panic on bad data is caught and reported.
 
+mod file;
 pub mod guard;
 mod series;
 
-use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 use dicom_dictionary_std::tags;
-use dicom_object::file::ReadPreamble;
-use dicom_object::mem::InMemElement;
-use dicom_object::{DefaultDicomObject, InMemDicomObject, OpenFileOptions, Tag};
-use glam::Vec3;
 
-use super::common::{Problem, ReadError, ReadOptions, file_len};
+use super::common::{Problem, ReadError, ReadOptions};
 use crate::volume::Volume;
+use file::{int, open, string};
 
 pub use series::FrameGeometry;
 
@@ -71,185 +68,4 @@ fn list_files(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
     }
     out.sort();
     Ok(out)
-}
-
-/// Reads and checks one file, then parses it.
-pub fn open(path: &Path, options: &ReadOptions) -> Result<DefaultDicomObject, ReadError> {
-    let fail = |p: Problem| ReadError::new(path, p);
-    let len = file_len(path)?;
-    if len > options.max_bytes + (64 << 20) {
-        return Err(fail(Problem::TooLarge(format!("a {len}-byte DICOM file"))));
-    }
-    let bytes = std::fs::read(path).map_err(|e| fail(Problem::Io(e)))?;
-    options.count_whole(len);
-    guard::check(&bytes).map_err(fail)?;
-    let (start, _) = guard::meta_start(&bytes).map_err(fail)?;
-    let from = &bytes[start - 4..];
-    // The guard bounds every allocation; a parser panic on some other inconsistency is
-    // still turned into an error rather than taking the application down.
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| OpenFileOptions::new().read_preamble(ReadPreamble::Never).from_reader(from)))
-        .map_err(|_| fail(Problem::Malformed("the DICOM parser failed on this file".into())))?
-        .map_err(|e| fail(Problem::Malformed(format!("DICOM parser: {e}"))))
-}
-
-// --- attribute access -------------------------------------------------------
-
-fn string(o: &InMemDicomObject, t: Tag) -> Option<String> {
-    o.get(t)?.to_str().ok().map(|s| s.trim().trim_end_matches('\0').to_string()).filter(|s| !s.is_empty())
-}
-
-fn floats(o: &InMemDicomObject, t: Tag) -> Option<Vec<f64>> {
-    o.get(t)?.to_multi_float64().ok().filter(|v| v.iter().all(|x| x.is_finite()))
-}
-
-fn float(o: &InMemDicomObject, t: Tag) -> Option<f64> {
-    o.get(t)?.to_float64().ok().filter(|x| x.is_finite())
-}
-
-fn int(o: &InMemDicomObject, t: Tag) -> Option<u32> {
-    o.get(t)?.to_int::<u32>().ok()
-}
-
-fn first_item(o: &InMemDicomObject, seq: Tag) -> Option<&InMemDicomObject> {
-    o.get(seq)?.items()?.first()
-}
-
-/// An attribute of a functional-group macro: per-frame first, then shared.
-fn group_value(o: &InMemDicomObject, frame: usize, macro_seq: Tag, tag: Tag) -> Option<&InMemElement> {
-    o.get(tags::PER_FRAME_FUNCTIONAL_GROUPS_SEQUENCE)
-        .and_then(|e| e.items())
-        .and_then(|v| v.get(frame))
-        .and_then(|it| first_item(it, macro_seq))
-        .and_then(|m| m.get(tag))
-        .or_else(|| {
-            first_item(o, tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE).and_then(|sh| first_item(sh, macro_seq)).and_then(|m| m.get(tag))
-        })
-}
-
-fn vec3(v: &[f64]) -> Vec3 {
-    Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
-}
-
-/// Pixel layout of an image object.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct PixelFormat {
-    rows: u32,
-    cols: u32,
-    bits_allocated: u16,
-    bits_stored: u16,
-    signed: bool,
-}
-
-impl PixelFormat {
-    fn of(o: &InMemDicomObject) -> Result<Self, Problem> {
-        let need = |t: Tag, name: &str| int(o, t).ok_or_else(|| Problem::Malformed(format!("{name} is missing")));
-        let samples = int(o, tags::SAMPLES_PER_PIXEL).unwrap_or(1);
-        if samples != 1 {
-            return Err(Problem::Unsupported(format!("{samples} samples per pixel (colour images); Focal reads grey-scale volumes")));
-        }
-        let f = PixelFormat {
-            rows: need(tags::ROWS, "Rows")?,
-            cols: need(tags::COLUMNS, "Columns")?,
-            bits_allocated: need(tags::BITS_ALLOCATED, "Bits Allocated")? as u16,
-            bits_stored: int(o, tags::BITS_STORED).unwrap_or(0) as u16,
-            signed: int(o, tags::PIXEL_REPRESENTATION).unwrap_or(0) == 1,
-        };
-        let f = PixelFormat { bits_stored: if f.bits_stored == 0 { f.bits_allocated } else { f.bits_stored }, ..f };
-        if !matches!(f.bits_allocated, 8 | 16 | 32) || f.bits_stored > f.bits_allocated {
-            return Err(Problem::Unsupported(format!("Bits Allocated {} / Bits Stored {}", f.bits_allocated, f.bits_stored)));
-        }
-        if f.rows == 0 || f.cols == 0 {
-            return Err(Problem::Malformed(format!("image size {}×{}", f.cols, f.rows)));
-        }
-        Ok(f)
-    }
-
-    fn frame_bytes(&self) -> usize {
-        self.rows as usize * self.cols as usize * (self.bits_allocated as usize / 8)
-    }
-
-    fn sample_type(&self) -> crate::volume::SampleType {
-        use crate::volume::SampleType::*;
-        match (self.bits_allocated, self.signed) {
-            (8, false) => U8,
-            (8, true) => I8,
-            (16, false) => U16,
-            (16, true) => I16,
-            (_, false) => U32,
-            (_, true) => I32,
-        }
-    }
-
-    /// Masks samples to Bits Stored and sign-extends them (little-endian bytes, in place).
-    fn normalise(&self, bytes: &mut [u8]) {
-        let (bits, stored) = (self.bits_allocated as u32, self.bits_stored as u32);
-        if stored >= bits {
-            return;
-        }
-        let size = bits as usize / 8;
-        let mask = (1u64 << stored) - 1;
-        let sign = 1u64 << (stored - 1);
-        for s in bytes.chunks_exact_mut(size) {
-            let mut a = [0u8; 8];
-            a[..size].copy_from_slice(s);
-            let mut v = u64::from_le_bytes(a) & mask;
-            if self.signed && v & sign != 0 {
-                v |= !mask;
-            }
-            s.copy_from_slice(&v.to_le_bytes()[..size]);
-        }
-    }
-}
-
-/// The pixel bytes of all frames of an object (little-endian samples).
-fn pixel_bytes<'a>(object: &'a DefaultDicomObject, format: &PixelFormat, frames: usize) -> Result<Cow<'a, [u8]>, Problem> {
-    let need = format.frame_bytes() * frames;
-    let element = object.element(tags::PIXEL_DATA).map_err(|_| Problem::Malformed("no Pixel Data".into()))?;
-    let bytes = match element.to_bytes() {
-        Ok(b) => b,
-        Err(_) => {
-            // Encapsulated (compressed) pixel data: let dicom-pixeldata decode it.
-            use dicom_pixeldata::PixelDecoder;
-            let decoded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| object.decode_pixel_data()))
-                .map_err(|_| Problem::Corrupt("the pixel data decoder failed on this data".into()))?
-                .map_err(|e| Problem::Unsupported(format!("pixel data: {e}")))?;
-            Cow::Owned(decoded.data().to_vec())
-        }
-    };
-    if bytes.len() < need {
-        return Err(Problem::Truncated(format!(
-            "Pixel Data holds {} bytes, {} frame(s) of {}×{} need {need}",
-            bytes.len(),
-            frames,
-            format.cols,
-            format.rows
-        )));
-    }
-    Ok(match bytes {
-        Cow::Borrowed(b) => Cow::Borrowed(&b[..need]),
-        Cow::Owned(mut b) => {
-            b.truncate(need);
-            Cow::Owned(b)
-        }
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn samples_are_masked_and_sign_extended() {
-        // 12 bits stored in 16: 0x0FFF is −1 when signed; bits above 12 are garbage.
-        let f = PixelFormat { rows: 1, cols: 3, bits_allocated: 16, bits_stored: 12, signed: true };
-        let mut b: Vec<u8> = [0xFFFFu16, 0xF800, 0x07FF].iter().flat_map(|v| v.to_le_bytes()).collect();
-        f.normalise(&mut b);
-        let v: Vec<i16> = b.chunks_exact(2).map(|c| i16::from_le_bytes([c[0], c[1]])).collect();
-        assert_eq!(v, vec![-1, -2048, 2047]);
-        let u = PixelFormat { signed: false, ..f };
-        let mut b: Vec<u8> = [0xF0FFu16].iter().flat_map(|v| v.to_le_bytes()).collect();
-        u.normalise(&mut b);
-        assert_eq!(u16::from_le_bytes([b[0], b[1]]), 0x00FF);
-        assert_eq!(u.sample_type(), crate::volume::SampleType::U16);
-    }
 }

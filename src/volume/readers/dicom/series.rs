@@ -6,10 +6,10 @@ use dicom_dictionary_std::tags;
 use dicom_object::{DefaultDicomObject, InMemDicomObject};
 use glam::{Mat3, Vec3};
 
-use super::{PixelFormat, float, floats, group_value, int, open, pixel_bytes, string, vec3};
+use super::file::{PixelFormat, float, floats, group_value, int, open, pixel_bytes, string, vec3};
 use crate::volume::encode::{ByteOrder, encode_samples, encode_values};
 use crate::volume::grid::{lps_axes_to_ras, lps_to_ras};
-use crate::volume::readers::common::{Problem, ReadError, ReadOptions};
+use crate::volume::readers::common::{Problem, ReadError, ReadOptions, volume_name};
 use crate::volume::{Grid, Source, ValueMap, Volume};
 
 /// Where one frame (or slice) lies, in LPS millimetres, and how to rescale its values.
@@ -166,7 +166,7 @@ pub fn read_multiframe(path: &Path, object: DefaultDicomObject, options: &ReadOp
         }
     }
     drop(all);
-    let name = string(&object, tags::SERIES_DESCRIPTION).unwrap_or_else(|| super::super::nifti::volume_name(path));
+    let name = string(&object, tags::SERIES_DESCRIPTION).unwrap_or_else(|| volume_name(path));
     assemble(path, &object, format, std::mem::take(&mut planes), name, "DICOM multi-frame", Vec::new())
 }
 

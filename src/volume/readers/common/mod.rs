@@ -1,4 +1,7 @@
-//! What every reader shares: errors, limits, bounded decompression, sample decoding.
+//! What every reader shares: errors, limits, bounded decompression, sample decoding,
+//! raw data of a known layout ([`raw_layout`], [`read_raw`]), names and sidecar files.
+
+pub mod raw_layout;
 
 use std::fs::File;
 use std::io::Read;
@@ -9,10 +12,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use flate2::read::{GzDecoder, ZlibDecoder};
 use glam::UVec3;
 
-use super::raw::RawSpec;
-use crate::volume::Voxels;
+pub use raw_layout::{RawSpec, parse_sample_type};
+
 use crate::volume::encode::{ByteOrder, Encoded, SampleType, encode_samples};
 use crate::volume::grid::fmt_dims;
+use crate::volume::{Grid, Source, Volume, Voxels};
 
 /// A file could not be read: which file, and why.
 #[derive(Debug, thiserror::Error)]
@@ -297,6 +301,79 @@ pub fn first_component(e: Encoded, n: usize) -> Encoded {
         Voxels::U16(v) => Voxels::U16(v.into_iter().step_by(n).collect()),
     };
     Encoded { voxels, map: e.map }
+}
+
+/// Reads raw data laid out as `spec` says; `format` and `details` describe where the
+/// spec came from.
+pub fn read_raw(
+    path: &Path,
+    spec: &RawSpec,
+    options: &ReadOptions,
+    format: &str,
+    details: Vec<(String, String)>,
+) -> Result<Volume, ReadError> {
+    let fail = |p: Problem| ReadError::new(path, p);
+    let (dims, len) = options.check_size(spec.dims.to_array().map(u64::from), spec.sample.size()).map_err(fail)?;
+    let gz = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gz"));
+    let mut skip_bytes = spec.skip;
+    if !gz {
+        let have = file_len(path)?;
+        if skip_bytes == -1 {
+            skip_bytes = have as i64 - len as i64;
+        }
+        if skip_bytes < 0 || have < skip_bytes as u64 + len as u64 {
+            return Err(fail(Problem::Truncated(format!(
+                "file has {have} bytes, {} needed for {} {} samples",
+                len as i64 + spec.skip.max(0),
+                spec.dims.x as u64 * spec.dims.y as u64 * spec.dims.z as u64,
+                spec.sample.name()
+            ))));
+        }
+    } else if skip_bytes < 0 {
+        return Err(fail(Problem::Malformed("skip -1 needs an uncompressed file".into())));
+    }
+    let mut stream = decoder(open_buffered(path, options)?, if gz { Compression::Gzip } else { Compression::None });
+    skip(&mut stream, skip_bytes as u64).map_err(fail)?;
+    let bytes = read_exact_bounded(stream, len).map_err(fail)?;
+    let encoded = encode(bytes, spec.sample, spec.order).map_err(fail)?;
+    let spacing = spec.spacing;
+    if !spacing.is_finite() || spacing.min_element() <= 0.0 {
+        return Err(fail(Problem::Malformed(format!("spacing {spacing} is not positive"))));
+    }
+    let grid = Grid::centered(dims, spacing);
+    let source = Source { format: format.into(), path: Some(path.to_path_buf()), sample_type: spec.sample.name().into(), details };
+    Volume::new(volume_name(path), grid, encoded.voxels, encoded.map, source).map_err(|e| fail(Problem::Malformed(e)))
+}
+
+/// Name shown for a volume: the file name without its extensions.
+pub fn volume_name(path: &Path) -> String {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "volume".into());
+    name.split('.').next().filter(|s| !s.is_empty()).unwrap_or(&name).to_string()
+}
+
+/// Sidecar candidates of a volume path: the name with its volume extension stripped
+/// and each of `exts` appended, plus the full name with `exts` appended (`aal.nii.txt`).
+pub fn sidecars(path: &Path, exts: &[&str]) -> Vec<PathBuf> {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let mut stems = vec![name.clone()];
+    for ext in [".nii.gz", ".gz", ".nii", ".nrrd", ".nhdr", ".mha", ".mhd", ".vti"] {
+        if let Some(s) = name.strip_suffix(ext) {
+            stems.push(s.to_string());
+            if let Some(s2) = s.strip_suffix(".nii") {
+                stems.push(format!("{s2}.nii"));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for stem in stems {
+        for ext in exts {
+            let p = path.with_file_name(format!("{stem}.{ext}"));
+            if !out.contains(&p) {
+                out.push(p);
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -1,0 +1,227 @@
+//! The bench's machinery: an offscreen view that shows one volume, configurations timed
+//! in interleaved rounds (medians), samples counted by the CPU reference, and the rows
+//! of the report.
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+use focal::dataset::{Dataset, VolumeView};
+use focal::lens::Lens;
+use focal::lens::systems::replace_lenses;
+use focal::region::{Appearance, View};
+use focal::render::headless::Offscreen;
+use focal::volume::Volume;
+
+pub(super) struct Row {
+    pub(super) group: &'static str,
+    pub(super) config: String,
+    pub(super) ms: f64,
+    pub(super) baseline: String,
+    pub(super) ratio: f64,
+    /// The picture's samples against the baseline's, where counted
+    /// ([`Bench::classified_samples`]).
+    pub(super) sample_ratio: Option<f64>,
+    pub(super) note: String,
+}
+
+pub(super) struct Bench {
+    pub(super) off: Offscreen,
+    pub(super) frames: u32,
+    pub(super) save: Option<std::path::PathBuf>,
+    /// The camera of the last [`Self::place`].
+    pub(super) camera: Option<focal::region::Camera>,
+}
+
+impl Bench {
+    pub(super) fn show(
+        &mut self,
+        volume: Arc<Volume>,
+        appearance: Appearance,
+        view: VolumeView,
+    ) -> Result<(f64, image::RgbaImage), String> {
+        self.place(volume, appearance);
+        self.off.set_view(view);
+        let image = self.off.capture()?;
+        let t = self.off.time_frames(self.frames);
+        Ok((t.as_secs_f64() * 1000.0, image))
+    }
+
+    /// Shows `volume` alone, framed from the oblique view; the camera and the volume's
+    /// centre.
+    pub(super) fn place(&mut self, volume: Arc<Volume>, appearance: Appearance) -> (focal::region::Camera, Vec3) {
+        let world = self.off.world_mut();
+        let old: Vec<Entity> = world.query_filtered::<Entity, With<Dataset>>().iter(world).collect();
+        for e in old {
+            world.despawn(e);
+        }
+        let (lo, hi) = appearance.visible_bounds(&volume).unwrap_or_else(|| volume.grid.world_bounds());
+        self.off.world_mut().spawn((Dataset::new(volume, appearance), Transform::default()));
+        let camera = View::Oblique.frame_box(lo, hi, self.off.width as f32 / self.off.height as f32, false);
+        self.off.set_camera(&camera);
+        self.camera = Some(camera);
+        (camera, (lo + hi) * 0.5)
+    }
+}
+
+/// A configuration timed by [`Bench::interleaved`]: name, lenses, view switches.
+pub(super) type Config = (&'static str, Vec<Lens>, VolumeView);
+
+impl Bench {
+    /// Shows `volume`, then times every configuration in rounds of one frame each and
+    /// takes each configuration's median: drift of the machine (other load, clock
+    /// changes) then hits all of them alike, which timing them one after another does
+    /// not. With `orbit`, the camera turns half a degree about the volume before every
+    /// frame (so what depends on the camera is recomputed each frame).
+    pub(super) fn interleaved(
+        &mut self,
+        volume: Arc<Volume>,
+        appearance: Appearance,
+        configs: &[Config],
+        orbit: bool,
+    ) -> Result<(Vec<f64>, Vec<image::RgbaImage>), String> {
+        self.interleaved_by(volume, appearance, configs.len(), orbit, |off, i| {
+            let (_, lenses, view) = &configs[i];
+            replace_lenses(off.world_mut(), lenses);
+            off.set_view(*view);
+        })
+    }
+
+    /// [`Self::interleaved`] over the appearances of one dataset (no lenses, `view`).
+    pub(super) fn interleaved_appearances(
+        &mut self,
+        volume: Arc<Volume>,
+        appearances: &[Appearance],
+        view: VolumeView,
+    ) -> Result<(Vec<f64>, Vec<image::RgbaImage>), String> {
+        let first = appearances.first().ok_or("no appearance to time")?.clone();
+        self.interleaved_by(volume, first, appearances.len(), false, |off, i| {
+            off.set_view(view);
+            let world = off.world_mut();
+            let mut q = world.query::<&mut Dataset>();
+            for mut d in q.iter_mut(world) {
+                d.appearance = appearances[i].clone();
+            }
+        })
+    }
+
+    /// The timing loop of [`Self::interleaved`]: `set(off, i)` switches to
+    /// configuration `i` of `count`.
+    pub(super) fn interleaved_by(
+        &mut self,
+        volume: Arc<Volume>,
+        appearance: Appearance,
+        count: usize,
+        orbit: bool,
+        mut set: impl FnMut(&mut Offscreen, usize),
+    ) -> Result<(Vec<f64>, Vec<image::RgbaImage>), String> {
+        let (camera, centre) = self.place(volume, appearance);
+        let mut turn = 0u32;
+        // Every configuration once first (pipelines, atlases), and its picture.
+        let mut images = Vec::new();
+        for i in 0..count {
+            set(&mut self.off, i);
+            images.push(self.off.capture()?);
+        }
+        let mut times = vec![Vec::new(); count];
+        for _ in 0..self.frames {
+            for (i, samples) in times.iter_mut().enumerate() {
+                set(&mut self.off, i);
+                // (An untimed frame first takes the switch.)
+                let t = self.off.time_frames_with(1, |off, _| {
+                    if orbit {
+                        turn += 1;
+                        let q = Quat::from_rotation_y(turn as f32 * 0.5f32.to_radians());
+                        off.set_camera(&focal::region::Camera {
+                            position: centre + q * (camera.position - centre),
+                            rotation: q * camera.rotation,
+                            ..camera
+                        });
+                    }
+                });
+                samples.push(t.as_secs_f64() * 1000.0);
+            }
+        }
+        if std::env::var_os("FOCAL_BENCH_SAMPLES").is_some() {
+            for (i, v) in times.iter().enumerate() {
+                eprintln!("config {i}: {}", v.iter().map(|t| format!("{t:.0}")).collect::<Vec<_>>().join(" "));
+            }
+        }
+        let medians = times
+            .into_iter()
+            .map(|mut v| {
+                v.sort_by(f64::total_cmp);
+                v[v.len() / 2]
+            })
+            .collect();
+        Ok((medians, images))
+    }
+}
+
+impl Bench {
+    /// The samples the regions take in each of `count` configurations (`set` switches to
+    /// one, as for [`Self::interleaved_by`]), counted by the CPU reference
+    /// ([`focal::reference::RenderedImage::classified`]) at 128 pixels across with the
+    /// bench's camera: what each picture costs a ray caster that skips empty space,
+    /// whatever its hardware.
+    pub(super) fn classified_samples(&mut self, count: usize, mut set: impl FnMut(&mut Offscreen, usize)) -> Result<Vec<u64>, String> {
+        let camera = self.camera.ok_or("no view placed to count samples in")?;
+        let across = 128.0 / self.off.width.max(self.off.height) as f32;
+        let (w, h) = ((self.off.width as f32 * across).round().max(1.0) as u32, (self.off.height as f32 * across).round().max(1.0) as u32);
+        (0..count)
+            .map(|i| {
+                set(&mut self.off, i);
+                self.off.update();
+                let scene = self.off.world_mut().resource::<focal::dataset::SceneRegions>().scene.clone();
+                Ok(focal::reference::render(&scene, &camera, w, h)?.classified)
+            })
+            .collect()
+    }
+}
+
+/// Names of configurations.
+pub(super) fn names(configs: &[Config]) -> Vec<&'static str> {
+    configs.iter().map(|c| c.0).collect()
+}
+
+impl Bench {
+    /// Writes a group's pictures when `--save` asked for them.
+    pub(super) fn save_images(&self, group: &str, images: &[image::RgbaImage]) -> Result<(), String> {
+        let Some(dir) = &self.save else { return Ok(()) };
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        for (i, im) in images.iter().enumerate() {
+            let path = dir.join(format!("{group}-{i}.png"));
+            im.save(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        Ok(())
+    }
+}
+
+impl Row {
+    /// The frame rate as a percentage of the baseline's (the paper's table 1 reports
+    /// it so): 100 / ratio.
+    pub(super) fn frame_rate_percent(&self) -> f64 {
+        100.0 / self.ratio.max(1e-9)
+    }
+}
+
+/// Rows of a group timed by [`Bench::interleaved`], against its first configuration.
+pub(super) fn push_group(rows: &mut Vec<Row>, group: &'static str, names: &[&str], ms: &[f64], base_note: &str, note: &str) {
+    let base = names[0].to_string();
+    for (i, (name, t)) in names.iter().zip(ms).enumerate() {
+        let note = if i == 0 { base_note } else { note };
+        rows.push(Row {
+            group,
+            config: name.to_string(),
+            ms: *t,
+            baseline: base.clone(),
+            ratio: t / ms[0].max(1e-9),
+            sample_ratio: None,
+            note: note.into(),
+        });
+    }
+}
+
+/// Largest channel difference between two images, in 8-bit levels.
+pub(super) fn difference(a: &image::RgbaImage, b: &image::RgbaImage) -> u8 {
+    a.pixels().zip(b.pixels()).flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c]))).max().unwrap_or(0)
+}

@@ -1,0 +1,42 @@
+//! The cameras that show the volumes: [`VolumeView`] marks one and holds its rendering
+//! switches; the renderer extracts it per view, the lenses are resolved per view.
+
+use bevy::prelude::*;
+
+use crate::region::Light;
+
+/// Marks a camera that shows the volumes, with its rendering switches.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct VolumeView {
+    /// Jitter ray starts per pixel (against wood-grain artefacts).
+    pub jitter: bool,
+    /// Skip bricks the transfer functions make invisible.
+    pub skip_empty: bool,
+    /// Stop rays once they are opaque.
+    pub early_termination: bool,
+    /// Show ray directions instead of the volumes (tests of ray generation).
+    pub debug_rays: bool,
+    /// Under lenses, sample compressed areas from the mip chain (`lens::antialias`).
+    pub lens_antialias: bool,
+    /// Feature lenses find their silhouettes in compute passes (else on the CPU).
+    pub gpu_silhouettes: bool,
+    /// Seed of the jitter pattern.
+    pub frame: u32,
+    /// Light of the view (copied from the scene each frame).
+    pub light: Light,
+}
+
+impl Default for VolumeView {
+    fn default() -> Self {
+        Self {
+            jitter: true,
+            skip_empty: true,
+            early_termination: true,
+            debug_rays: false,
+            lens_antialias: true,
+            gpu_silhouettes: true,
+            frame: 0,
+            light: Light::Headlight,
+        }
+    }
+}

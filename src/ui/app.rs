@@ -1,0 +1,320 @@
+//! The app: the window, its plugin (panels, camera control, loading, shortcuts) and the
+//! systems that are the app's own (screenshots, automation, reframing, picking the
+//! orbit centre).
+
+use crate::context::ContextParams;
+use std::path::PathBuf;
+
+use bevy::camera::CameraOutputMode;
+use bevy::camera::visibility::RenderLayers;
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::diagnostic::FrameTimeDiagnosticsPlugin;
+use bevy::prelude::*;
+use bevy::render::render_resource::BlendState;
+use bevy::render::view::screenshot::{Screenshot, save_to_disk};
+use bevy::window::PrimaryWindow;
+use bevy_egui::{EguiGlobalSettings, EguiPlugin, EguiPrimaryContextPass, PrimaryEguiContext};
+
+use super::loading::{LoadRequest, LoadingPlugin, Reframe, Session};
+use super::orbit::{OrbitCamera, PointerInViewport, toggle_fly};
+use super::state::{AppState, DialogPurpose, MainCamera, default_scene, scene_bounds};
+use super::viewport::viewport_logical;
+use super::{clip_gizmo, explode_overlay, explode_panel, explode_tools, lenses, loading, orbit, panels, window_tools};
+use crate::dataset::{SceneRegions, VolumeView};
+use crate::region::View;
+
+/// The app: panels, camera control, loading.
+pub struct FocalAppPlugin {
+    /// File, folder or scene to open at start (the default scene when `None`).
+    pub initial: Option<PathBuf>,
+    /// Automation for tests: screenshot after N frames to a path, then exit.
+    pub screenshot_and_exit: Option<(u32, PathBuf)>,
+}
+
+impl Plugin for FocalAppPlugin {
+    fn build(&self, app: &mut App) {
+        let initial = self.initial.clone();
+        app.add_plugins((EguiPlugin::default(), FrameTimeDiagnosticsPlugin::default(), LoadingPlugin))
+            .insert_resource(AppState { screenshot_and_exit: self.screenshot_and_exit.clone(), ..Default::default() })
+            .init_resource::<PointerInViewport>()
+            .init_resource::<lenses::LensUi>()
+            .init_resource::<clip_gizmo::ClipGizmo>()
+            .init_resource::<window_tools::WindowTools>()
+            .init_resource::<explode_tools::ExplodeUi>()
+            .init_resource::<explode_overlay::CutPreview>()
+            .add_systems(
+                Startup,
+                move |mut commands: Commands, mut egui: ResMut<EguiGlobalSettings>, mut load: MessageWriter<LoadRequest>| {
+                    setup(&mut commands, &mut egui);
+                    load.write(match &initial {
+                        Some(p) => LoadRequest::Path(p.clone()),
+                        None => LoadRequest::Scene(default_scene(), PathBuf::new()),
+                    });
+                },
+            )
+            .add_systems(
+                Update,
+                (
+                    lenses::lens_input,
+                    lenses::lens_keys,
+                    explode_panel::explode_input,
+                    clip_gizmo::clip_input,
+                    window_tools::window_input,
+                    orbit::orbit_input,
+                    orbit::fly_keys,
+                    shortcuts,
+                    dropped_files,
+                    centre_on_double_click,
+                    reframe,
+                    sync_view,
+                    automation,
+                    orbit::apply_orbit,
+                )
+                    .chain(),
+            )
+            // The exploded views' physics: as many steps as the frame's time asks for.
+            .add_systems(Update, (crate::explode::systems::run_steps, open_explode_panel).after(orbit::apply_orbit))
+            .add_systems(EguiPrimaryContextPass, (panels::ui, explode_panel::explode_panel, explode_overlay::explode_overlay).chain());
+    }
+}
+
+fn setup(commands: &mut Commands, egui: &mut EguiGlobalSettings) {
+    // The 3D view and a separate camera for the panels, so the view can be limited to
+    // the free part of the window.
+    egui.auto_create_primary_context = false;
+    let orbit = OrbitCamera::default();
+    let (transform, projection) = orbit.bevy();
+    commands.spawn((
+        MainCamera,
+        Camera3d::default(),
+        Msaa::Off,
+        Tonemapping::None,
+        Camera { clear_color: Color::BLACK.into(), ..default() },
+        transform,
+        projection,
+        orbit,
+        VolumeView::default(),
+        crate::windows::Viewer,
+    ));
+    commands.spawn((
+        PrimaryEguiContext,
+        Camera2d,
+        RenderLayers::none(),
+        Camera {
+            order: 1,
+            output_mode: CameraOutputMode::Write { blend_state: Some(BlendState::ALPHA_BLENDING), clear_color: ClearColorConfig::None },
+            clear_color: ClearColorConfig::None,
+            ..default()
+        },
+    ));
+    commands.spawn((DirectionalLight::default(), Transform::from_xyz(1.0, -2.0, 3.0).looking_at(Vec3::ZERO, Vec3::Z)));
+}
+
+/// Opens dropped files and folders.
+fn dropped_files(mut drops: MessageReader<FileDragAndDrop>, mut load: MessageWriter<LoadRequest>) {
+    for d in drops.read() {
+        if let FileDragAndDrop::DroppedFile { path_buf, .. } = d {
+            load.write(LoadRequest::Path(path_buf.clone()));
+        }
+    }
+}
+
+/// Keyboard shortcuts (ignored while egui has the keyboard).
+fn shortcuts(
+    keys: Res<ButtonInput<KeyCode>>,
+    mut state: ResMut<AppState>,
+    mut contexts: bevy_egui::EguiContexts,
+    mut cams: Query<&mut OrbitCamera>,
+    regions: Res<SceneRegions>,
+    mut commands: Commands,
+    mut datasets: Query<&mut crate::dataset::Dataset>,
+) {
+    if contexts.ctx_mut().is_ok_and(|c| c.egui_wants_keyboard_input()) {
+        return;
+    }
+    let ctrl = keys.any_pressed([KeyCode::ControlLeft, KeyCode::ControlRight]);
+    if keys.just_pressed(KeyCode::KeyH) || keys.just_pressed(KeyCode::F1) {
+        state.show_help = !state.show_help;
+    }
+    if keys.just_pressed(KeyCode::KeyF) {
+        state.show_fps = !state.show_fps;
+    }
+    if keys.just_pressed(KeyCode::KeyE) {
+        state.show_explode = !state.show_explode;
+    }
+    if keys.just_pressed(KeyCode::F12) || (keys.just_pressed(KeyCode::KeyS) && !ctrl) {
+        let path = screenshot_path();
+        commands.spawn(Screenshot::primary_window()).observe(save_to_disk(path.clone()));
+        state.last_screenshot = Some(path);
+    }
+    if ctrl && keys.just_pressed(KeyCode::KeyO) {
+        state.dialog_purpose = DialogPurpose::Open;
+        state.dialog.pick_file();
+    }
+    if ctrl && keys.just_pressed(KeyCode::KeyS) {
+        state.dialog_purpose = DialogPurpose::SaveScene;
+        state.dialog.save_file();
+    }
+    if keys.just_pressed(KeyCode::KeyM) {
+        let selected = state.selected;
+        if let Some(mut d) = datasets.iter_mut().nth(selected) {
+            let modes = crate::region::Mode::ALL;
+            let i = modes.iter().position(|m| *m == d.appearance.mode).unwrap_or(0);
+            d.appearance.mode = modes[(i + 1) % modes.len()];
+        }
+    }
+    for (key, delta) in [(KeyCode::BracketLeft, -ContextParams::KAPPA_T_STEP), (KeyCode::BracketRight, ContextParams::KAPPA_T_STEP)] {
+        if keys.just_pressed(key)
+            && let Some(mut d) = datasets.iter_mut().nth(state.selected)
+        {
+            d.appearance.context = d.appearance.context.with_kappa_t_step(delta);
+        }
+    }
+    let Ok(mut orbit) = cams.single_mut() else { return };
+    let views = [
+        (KeyCode::Digit1, View::Anterior),
+        (KeyCode::Digit2, View::Posterior),
+        (KeyCode::Digit3, View::Left),
+        (KeyCode::Digit4, View::Right),
+        (KeyCode::Digit5, View::Superior),
+        (KeyCode::Digit6, View::Inferior),
+        (KeyCode::Digit7, View::Oblique),
+    ];
+    let bounds = scene_bounds(&regions);
+    for (key, view) in views {
+        if keys.just_pressed(key) {
+            orbit.frame(view, bounds.0, bounds.1, 1.0);
+        }
+    }
+    if keys.just_pressed(KeyCode::KeyR) {
+        orbit.frame(View::Oblique, bounds.0, bounds.1, 1.0);
+    }
+    if keys.just_pressed(KeyCode::KeyP) {
+        orbit.orthographic = !orbit.orthographic;
+    }
+    if keys.just_pressed(KeyCode::KeyV) {
+        toggle_fly(&mut orbit, bounds);
+    }
+}
+
+/// Opens the exploded view's panel when a dataset is exploded (a scene that explodes
+/// one, or the panel's own Explode) and selects it.
+fn open_explode_panel(
+    added: Query<Entity, Added<crate::explode::Exploded>>,
+    datasets: Query<Entity, With<crate::dataset::Dataset>>,
+    mut state: ResMut<AppState>,
+) {
+    let Some(e) = added.iter().min() else { return };
+    let mut all: Vec<Entity> = datasets.iter().collect();
+    all.sort();
+    state.show_explode = true;
+    state.selected = all.iter().position(|d| *d == e).unwrap_or(state.selected);
+}
+
+/// Where screenshots go.
+fn screenshot_path() -> PathBuf {
+    let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
+    let dir = PathBuf::from("out");
+    let _ = std::fs::create_dir_all(&dir);
+    dir.join(format!("screenshot-{stamp}.png"))
+}
+
+/// Frames newly loaded data.
+/// Places the camera on newly loaded data: a scene's own camera, else an oblique view.
+fn reframe(mut session: ResMut<Session>, mut cams: Query<(&mut OrbitCamera, &Camera), With<MainCamera>>) {
+    let Ok((mut orbit, camera)) = cams.single_mut() else { return };
+    let Some(Reframe { bounds: (lo, hi), camera: spec }) = session.reframe.take() else { return };
+    let aspect = camera.physical_viewport_size().map_or(1.0, |s| s.x as f32 / s.y.max(1) as f32);
+    match spec {
+        Some(spec) => orbit.set_from(&crate::scene::load::camera(&spec, (lo, hi), aspect), (lo + hi) * 0.5),
+        None => orbit.frame(View::Oblique, lo, hi, aspect),
+    }
+}
+
+/// Double-click centres the orbit on the first visible point under the cursor (picked
+/// with the CPU reference renderer).
+fn centre_on_double_click(
+    buttons: Res<ButtonInput<MouseButton>>,
+    windows: Query<&Window, With<PrimaryWindow>>,
+    time: Res<Time<Real>>,
+    pointer: Res<PointerInViewport>,
+    regions: Res<SceneRegions>,
+    mut last: Local<(f64, Vec2)>,
+    mut cams: Query<(&mut OrbitCamera, &Camera), With<MainCamera>>,
+    mut state: ResMut<AppState>,
+    datasets: Query<(Entity, &crate::dataset::Dataset, Option<&crate::dataset::GpuVolume>)>,
+) {
+    let Ok(window) = windows.single() else { return };
+    if !pointer.inside {
+        return;
+    }
+    let Some(cursor) = orbit::double_click(&buttons, window, time.elapsed_secs_f64(), &mut last) else { return };
+    let Ok((mut orbit, camera)) = cams.single_mut() else { return };
+    let (origin, size) = viewport_logical(camera, window);
+    let p = cursor - origin;
+    let ray = orbit.camera().ray(p.x, p.y, size.x.max(1.0) as u32, size.y.max(1.0) as u32);
+    if let Ok(Some(hit)) = crate::reference::pick(&regions.scene, ray) {
+        orbit.target = hit.position;
+        // On a label volume, the label there is picked (named and marked in its list).
+        let picked = crate::reference::label_at(&regions.scene, &hit).and_then(|id| {
+            let volume = regions.scene.regions.get(hit.region).and_then(|r| regions.scene.volumes.get(r.volume))?;
+            let (entity, ..) = datasets.iter().find(|(_, d, gpu)| {
+                std::sync::Arc::ptr_eq(&d.volume, volume) || gpu.is_some_and(|g| std::sync::Arc::ptr_eq(&g.volume, volume))
+            })?;
+            Some((entity, id))
+        });
+        if state.editor.picked_label != picked {
+            state.editor.picked_label = picked;
+        }
+    }
+}
+
+/// Copies the app's background and switches to the camera.
+fn sync_view(state: Res<AppState>, mut cams: Query<(&mut Camera, &mut VolumeView), With<MainCamera>>) {
+    if !state.is_changed() {
+        return;
+    }
+    for (mut cam, mut view) in &mut cams {
+        let [r, g, b] = state.background;
+        cam.clear_color = Color::srgb(r, g, b).into();
+        let light = view.light;
+        *view = VolumeView { light, ..state.view };
+    }
+}
+
+/// Test automation: a screenshot after N frames (counted once loading is done, the ray
+/// caster has drawn the volumes and no pipeline is still compiling, so the shot never shows a half-built first frame),
+/// then exit as soon as it is written.
+fn automation(
+    mut state: ResMut<AppState>,
+    mut commands: Commands,
+    mut exit: MessageWriter<AppExit>,
+    loading: Query<(), With<loading::Loading>>,
+    progress: Option<Res<crate::render::RenderProgress>>,
+) {
+    let Some((after, path)) = state.screenshot_and_exit.clone() else { return };
+    let settled = progress.is_some_and(|p| p.volumes_drawn() > 0 && p.pipelines_settled());
+    if !loading.is_empty() || !settled {
+        return;
+    }
+    state.frames += 1;
+    if state.frames == after {
+        let _ = std::fs::remove_file(&path);
+        commands.spawn(Screenshot::primary_window()).observe(save_to_disk(path.clone()));
+    }
+    if state.frames > after && (path.exists() || state.frames > after + 20) {
+        exit.write(AppExit::Success);
+    }
+}
+
+/// Runs the app.
+pub fn run(initial: Option<PathBuf>, screenshot_and_exit: Option<(u32, PathBuf)>, window: (u32, u32)) -> AppExit {
+    App::new()
+        .add_plugins(DefaultPlugins.set(WindowPlugin {
+            primary_window: Some(Window { title: "Focal".into(), resolution: window.into(), ..default() }),
+            ..default()
+        }))
+        .add_plugins((crate::FocalPlugins, crate::windows::frames::WindowFramePlugin))
+        .add_plugins(FocalAppPlugin { initial, screenshot_and_exit })
+        .run()
+}
