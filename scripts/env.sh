@@ -22,6 +22,19 @@ ensure_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}" >&2
 }
 
+# rustfmt and clippy, the lint gates of scripts/test.sh (rustup's default profile has
+# them; added when a minimal toolchain lacks them).
+ensure_lint_tools() {
+  if cargo fmt --version >/dev/null 2>&1 && cargo clippy --version >/dev/null 2>&1; then
+    return 0
+  fi
+  echo "installing: rustfmt clippy (rustup component add)" >&2
+  rustup component add rustfmt clippy >&2 || {
+    echo "scripts/test.sh needs rustfmt and clippy: install them with 'rustup component add rustfmt clippy'" >&2
+    return 1
+  }
+}
+
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 ensure_packages
 

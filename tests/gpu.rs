@@ -302,10 +302,12 @@ fn two_datasets_in_one_scene(gpu: &mut Gpu) {
     let cam = View::Anterior.frame_box(Vec3::new(-16.0, -16.0, -16.0), Vec3::new(56.0, 16.0, 16.0), 1.0, true);
     gpu.off.set_camera(&cam);
     let img = gpu.off.capture().unwrap();
-    let mut scene = RenderScene::default();
-    scene.volumes = vec![a.clone(), b.clone()];
-    scene.appearances = vec![app.clone(), app];
-    scene.regions = vec![focal::region::Region::volume_box(&a.grid, 0, 0), focal::region::Region::volume_box(&b.grid, 1, 1)];
+    let scene = RenderScene {
+        regions: vec![focal::region::Region::volume_box(&a.grid, 0, 0), focal::region::Region::volume_box(&b.grid, 1, 1)],
+        volumes: vec![a, b],
+        appearances: vec![app.clone(), app],
+        ..Default::default()
+    };
     let reference = render(&scene, &cam, SIZE, SIZE).unwrap().to_image().unwrap();
     assert_matches("two_datasets", &img, &reference);
 }
@@ -324,6 +326,9 @@ fn oversized_volumes_are_reduced_with_a_warning(gpu: &mut Gpu) {
     gpu.off.world_mut().insert_resource(focal::dataset::gpu_fit::GpuLimits::default());
 }
 
+/// A GPU test: its name and the function that runs it on the shared device.
+type GpuTest = (&'static str, fn(&mut Gpu));
+
 fn main() {
     let mut off = match Offscreen::new(SIZE, SIZE, |app| {
         app.add_plugins(FocalPlugins);
@@ -337,7 +342,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [(&str, fn(&mut Gpu)); 24] = [
+    let tests: [GpuTest; 24] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),

@@ -9,7 +9,8 @@ use focal::volume::readers::{Problem, RawSpec, ReadOptions, label_table, read_la
 use focal::volume::{Volume, Voxels};
 use glam::{Mat4, Vec3, Vec4};
 
-/// Expected facts about one file. `affine` is the index→world RAS matrix, row-major.
+/// Expected facts about one file. `affine` is the index→world RAS matrix, row-major, as
+/// an independent reader prints it (in f64; Focal's grid holds f32).
 struct Truth {
     dims: [u32; 3],
     bits: u32,
@@ -18,7 +19,7 @@ struct Truth {
     mean: f64,
     /// (index, real value).
     samples: [([u32; 3], f64); 3],
-    affine: [[f32; 4]; 3],
+    affine: [[f64; 4]; 3],
 }
 
 fn check(v: &Volume, t: &Truth, affine_tol: f32) {
@@ -32,7 +33,7 @@ fn check(v: &Volume, t: &Truth, affine_tol: f32) {
     let m = Mat4::from(v.grid.index_to_world());
     for (r, row) in t.affine.iter().enumerate() {
         let got = m.row(r);
-        let want = Vec4::from_array(*row);
+        let want = Vec4::from_array(row.map(|x| x as f32));
         assert!((got - want).abs().max_element() < affine_tol, "{} affine row {r}: {got} vs {want}", v.name);
     }
 }

@@ -5,7 +5,8 @@
 //! millimetres). Every frame [`collect_regions`] turns the datasets into the
 //! [`SceneRegions`] both renderers draw: one region per visible dataset, its box mapped
 //! through the inverse of the dataset's transform. Later techniques (windows, exploded
-//! parts) add or replace regions after it, in [`RegionSystems::Modify`].
+//! parts) add or replace regions after it, in [`RegionSystems::Modify`]. Cameras that
+//! show the volumes carry a [`VolumeView`] ([`view`]).
 
 pub mod gpu_fit;
 pub mod view;

@@ -420,7 +420,7 @@ pub fn spec_of(source: &ExplodeSpec, x: &Exploded, parts: &[(Entity, &Part)], jo
         }
     }
     let mut joints: Vec<_> = joints.iter().filter_map(|j| super::spec::JointSpec::of(j, index)).collect();
-    joints.sort_by(|a, b| (a.part, a.to).cmp(&(b.part, b.to)));
+    joints.sort_by_key(|a| (a.part, a.to));
     let c = x.coefficients;
     ExplodeSpec {
         degree: c.degree,
@@ -442,6 +442,8 @@ pub fn spec_of(source: &ExplodeSpec, x: &Exploded, parts: &[(Entity, &Part)], jo
 pub struct CurrentSpecs(pub std::collections::HashMap<Entity, Option<ExplodeSpec>>);
 
 /// Keeps [`CurrentSpecs`] up to date when parts, joints or explosions change.
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::type_complexity)]
 pub fn update_current_specs(
     datasets: Query<(Entity, Option<&ExplodeSource>, Option<&Exploded>), With<Dataset>>,

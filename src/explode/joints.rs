@@ -144,6 +144,8 @@ pub fn rapier_joint(joint: &PartJoint) -> GenericJoint {
 /// Gives each new or changed joint its rapier joint (a child of its part; a changed
 /// other end needs a new joint, which rapier cannot re-parent). Joints whose part or
 /// other end is gone are removed.
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::type_complexity)]
 pub fn build_joints(
     mut commands: Commands,

@@ -127,6 +127,8 @@ pub fn spawn_part(world: &mut World, part: Part, motion: Transform) -> Entity {
 }
 
 /// Keeps each part's body kind and mass in step with it (infinite mass = fixed).
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::type_complexity)]
 pub fn sync_bodies(
     mut parts: Query<(&Part, &mut RigidBody, &mut ColliderMassProperties, &mut Damping, &mut ExternalForce), Changed<Part>>,
@@ -152,6 +154,8 @@ pub fn sync_bodies(
 }
 
 /// Recomputes the explosion points of datasets whose selection or look changed.
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::type_complexity)]
 pub fn update_points(
     mut commands: Commands,
@@ -188,6 +192,8 @@ const FADE_FLOOR: f32 = 0.1;
 
 /// Sets every part's external force and torque for the coming step (equations 1–5, in
 /// the dataset's frame).
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::type_complexity)]
 pub fn apply_forces(
     mut parts: Query<(Entity, &Part, &Transform, &mut ExternalForce, Option<&mut PartFade>)>,

@@ -108,6 +108,15 @@ struct Sampling<'r> {
     depth_threshold: f32,
 }
 
+/// Where one sample is taken: its continuous voxel index, its ray parameter and the
+/// index of the region it samples.
+#[derive(Clone, Copy)]
+struct SamplePoint {
+    q: Vec3,
+    t: f32,
+    region: usize,
+}
+
 /// Traces one ray. `jitter` ∈ [0, 1) offsets the samples; `depth_threshold` is the
 /// accumulated opacity that defines the depth (and ends the ray when `stop_at_depth`).
 pub fn trace(regions: &[PreparedRegion], light: Light, ray: Ray, jitter: f32, depth_threshold: f32, stop_at_depth: bool) -> Traced {
@@ -176,7 +185,7 @@ pub fn trace_antialiased(
             let q = r.region.world_to_voxel.transform_point3(p);
             match &r.objects {
                 None => {
-                    sample(&mut out, r, &mut st.gathered, st.ratio, q, t, i, &at);
+                    sample(&mut out, r, &mut st.gathered, st.ratio, SamplePoint { q, t, region: i }, &at);
                     st.done = st.gathered.done;
                 }
                 Some(objects) => {
@@ -196,7 +205,7 @@ pub fn trace_antialiased(
                         iso_surface(&mut out, shown, q, t, i, &at);
                         st.gathered.done = true;
                     } else {
-                        sample(&mut out, shown, &mut st.gathered, st.ratio, q, t, i, &at);
+                        sample(&mut out, shown, &mut st.gathered, st.ratio, SamplePoint { q, t, region: i }, &at);
                     }
                 }
             }
@@ -217,8 +226,8 @@ pub fn trace_antialiased(
 /// One sample of region `r` (or of one part of a segmented region) at voxel position
 /// `q`, ray parameter `t`: composited at once (DVR modes), gathered (projections) or
 /// tested for a crossing (iso-surfaces).
-#[allow(clippy::too_many_arguments)]
-fn sample(out: &mut Traced, r: &PreparedRegion, g: &mut Gathered, ratio: f32, q: Vec3, t: f32, i: usize, at: &Sampling) {
+fn sample(out: &mut Traced, r: &PreparedRegion, g: &mut Gathered, ratio: f32, p: SamplePoint, at: &Sampling) {
+    let SamplePoint { q, t, region: i } = p;
     let (ray, light, level, depth_threshold) = (at.ray, at.light, at.level, at.depth_threshold);
     let view = ray.dir;
     match r.mode {

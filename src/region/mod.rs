@@ -6,7 +6,10 @@
 //! (its box, cut by clip planes); volumetric windows and exploded parts add regions with
 //! other maps. The per-pixel function intersects the ray with every region, giving
 //! intervals, and walks them front to back. This module holds the pure geometry, shared
-//! by the CPU reference renderer, the GPU packing and the techniques that make regions.
+//! by the CPU reference renderer, the GPU packing and the techniques that make regions;
+//! [`appearance`] the looks (with two-level rendering's objects), [`appearance_spec`]
+//! how scene files write them, [`camera`] cameras and rays, [`scene`] what a renderer
+//! draws.
 
 pub mod appearance;
 pub mod appearance_spec;

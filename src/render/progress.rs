@@ -24,6 +24,7 @@ impl RenderProgress {
     }
 }
 
+/// Records whether every queued pipeline is built (render world, each frame).
 pub fn record_pipeline_state(progress: Res<RenderProgress>, cache: Res<bevy::render::render_resource::PipelineCache>) {
     progress.0.1.store(cache.waiting_pipelines().next().is_none(), Ordering::Relaxed);
 }

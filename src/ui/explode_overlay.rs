@@ -29,6 +29,8 @@ const CUT: egui::Color32 = egui::Color32::from_rgb(255, 200, 60);
 const JOINT: egui::Color32 = egui::Color32::from_rgb(120, 230, 160);
 
 /// Draws the cut preview and the joints of the selected dataset.
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::too_many_arguments)]
 pub fn explode_overlay(
     mut contexts: EguiContexts,

@@ -28,6 +28,8 @@ use crate::explode::splitters::ScreenAxis;
 use crate::explode::{Exploded, JointKind, Part, PartJoint};
 
 /// Viewport input of the explode tools (after the lenses', before the camera's).
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::too_many_arguments)]
 pub fn explode_input(
     buttons: Res<ButtonInput<MouseButton>>,
@@ -123,13 +125,15 @@ fn line_overlay(ctx: &egui::Context, ui: &ExplodeUi, origin: Vec2, cursor: Optio
 }
 
 /// The part entities of `dataset`, in entity order (the order scene files list them).
-fn parts_of<'a>(parts: &'a Query<(Entity, &mut Part)>, dataset: Entity) -> Vec<Entity> {
+fn parts_of(parts: &Query<(Entity, &mut Part)>, dataset: Entity) -> Vec<Entity> {
     let mut v: Vec<Entity> = parts.iter().filter(|(_, p)| p.dataset == dataset).map(|(e, _)| e).collect();
     v.sort();
     v
 }
 
 /// The panel.
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn explode_panel(
     mut contexts: EguiContexts,

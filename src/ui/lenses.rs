@@ -27,6 +27,9 @@ use crate::lens::{Lens, LensKind, MAX_LENSES, Profile, ResolvedLens, Sampling, S
 /// Pixels within which a rim grabs.
 const GRAB_PIXELS: f32 = 6.0;
 
+/// What a lattice was computed for: the view's lenses and the scene's bounding sphere.
+type LatticeKey = (ViewLenses, (Vec3, f32));
+
 /// The app's lens tools.
 #[derive(Resource)]
 pub struct LensUi {
@@ -40,9 +43,8 @@ pub struct LensUi {
     pub show_outlines: bool,
     pub show_lattice: bool,
     pub show_readout: bool,
-    /// The lattice last computed, with the view lenses and scene bounds it was
-    /// computed for.
-    lattice: Option<((ViewLenses, (Vec3, f32)), Vec<[Vec2; 2]>)>,
+    /// The lattice last computed, with what it was computed for.
+    lattice: Option<(LatticeKey, Vec<[Vec2; 2]>)>,
     /// The view lenses with their silhouettes found on the CPU, for the overlays (the
     /// render finds them on the GPU), and the view lenses they were found for.
     on_cpu: Option<(ViewLenses, Vec<ResolvedLens>)>,

@@ -61,7 +61,8 @@ pub struct DatasetOrigin(pub DatasetSpec);
 #[derive(Message, Clone, Debug)]
 pub enum LoadRequest {
     Path(PathBuf),
-    Scene(SceneFile, PathBuf),
+    /// A scene (boxed: a message is moved around by value) and its folder.
+    Scene(Box<SceneFile>, PathBuf),
 }
 
 /// A scene showing one data file with its default look (labels shown as labels when a
@@ -99,7 +100,7 @@ pub fn start_loads(mut commands: Commands, mut requests: MessageReader<LoadReque
                 "scene".to_string(),
                 Box::new(move || {
                     let datasets = load_datasets_with(&scene, &base, Some(p))?;
-                    Ok((scene, base, datasets, true))
+                    Ok((*scene, base, datasets, true))
                 }),
             ),
         };

@@ -66,6 +66,8 @@ type DatasetQuery<'w, 's> =
     Query<'w, 's, (Entity, &'static mut Dataset, Option<&'static GpuVolume>, Option<&'static DatasetOrigin>, &'static Transform)>;
 
 /// Everything the panels read and edit.
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::too_many_arguments)]
 pub fn ui(
     mut contexts: EguiContexts,
@@ -108,7 +110,7 @@ pub fn ui(
                     state.dialog.save_file();
                 }
                 if ui.button("Head phantom").clicked() {
-                    load.write(LoadRequest::Scene(default_scene(), Default::default()));
+                    load.write(LoadRequest::Scene(Box::new(default_scene()), Default::default()));
                 }
             });
             ui.menu_button("View", |ui| {
@@ -290,11 +292,13 @@ pub fn ui(
                 let result = save_scene(
                     &path,
                     &ds_states(&datasets),
-                    cams.single().map(|(o, _)| o.camera()).ok(),
-                    state.background,
-                    light.0,
+                    ViewState {
+                        camera: cams.single().map(|(o, _)| o.camera()).ok(),
+                        background: state.background,
+                        light: light.0,
+                        lenses: &lens_params.ordered().into_iter().map(|(_, l, _)| l).collect::<Vec<_>>(),
+                    },
                     &session,
-                    &lens_params.ordered().into_iter().map(|(_, l, _)| l).collect::<Vec<_>>(),
                     windows,
                     &explode_specs,
                 );
@@ -501,19 +505,25 @@ fn ds_states<'a>(datasets: &'a DatasetQuery) -> Vec<DatasetRow<'a>> {
     rows
 }
 
-#[allow(clippy::too_many_arguments)]
-fn save_scene(
-    path: &std::path::Path,
-    rows: &[DatasetRow],
+/// What the view shows besides the datasets, for saving it.
+struct ViewState<'a> {
     camera: Option<crate::region::Camera>,
     background: [f32; 3],
     light: Light,
+    lenses: &'a [crate::lens::Lens],
+}
+
+/// Writes the app's state as a scene file at `path` (`.ron` added when missing).
+fn save_scene(
+    path: &std::path::Path,
+    rows: &[DatasetRow],
+    view: ViewState,
     session: &Session,
-    lenses: &[crate::lens::Lens],
     windows: crate::windows::spec::WindowScene,
     explode: &crate::explode::edit::CurrentSpecs,
 ) -> Result<(), String> {
     use crate::scene::save::{DatasetState, scene_file};
+    let ViewState { camera, background, light, lenses } = view;
     let states: Vec<DatasetState> = rows
         .iter()
         .map(|(e, o, d, t)| DatasetState {

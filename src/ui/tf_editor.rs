@@ -131,15 +131,15 @@ pub fn editor(ui: &mut egui::Ui, tf: &mut TransferFunction, hist: &Histogram, st
     let n = points.len();
     let mut remove = None;
     let mut line = Vec::with_capacity(n);
-    for i in 0..n {
-        let OpacityPoint(v, a) = points[i];
+    for (i, point) in points.iter_mut().enumerate() {
+        let OpacityPoint(v, a) = *point;
         let c = to_screen(to_frac(v), a);
         let handle = ui.interact(Rect::from_center_size(c, vec2(12.0, 12.0)), resp.id.with(("opacity", i)), Sense::click_and_drag());
         if handle.dragged() {
             let d = handle.drag_delta();
             let f = (to_frac(v) + d.x / r.width()).clamp(0.0, 1.0);
             let a = (a - d.y / r.height()).clamp(0.0, 1.0);
-            points[i] = OpacityPoint(from_frac(f), a);
+            *point = OpacityPoint(from_frac(f), a);
             changed = true;
         }
         if handle.secondary_clicked() && n > 2 {

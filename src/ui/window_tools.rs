@@ -68,6 +68,8 @@ fn place_window(w: &mut VolumeWindow, t: &mut Transform, centre: Vec3, size: Opt
 }
 
 /// Viewport input for windows and the 3D pointer; runs before the camera's.
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn window_input(
     (buttons, keys, scroll): (Res<ButtonInput<MouseButton>>, Res<ButtonInput<KeyCode>>, Res<AccumulatedMouseScroll>),

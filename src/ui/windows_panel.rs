@@ -19,6 +19,8 @@ use crate::windows::{Attachment, Automation, Content, Fit, Orientation, Pointer3
 /// The window entities and the commands to add and remove them.
 #[derive(SystemParam)]
 pub struct WindowParams<'w, 's> {
+    // A query's type names the components it reads and the ones it excludes; an alias
+    // would only hide that.
     #[allow(clippy::type_complexity)]
     pub windows: Query<'w, 's, (Entity, &'static mut VolumeWindow, &'static GlobalTransform), (Without<Dataset>, Without<MainCamera>)>,
     pub sources: Query<'w, 's, (&'static SourceBox, &'static GlobalTransform)>,

@@ -96,6 +96,8 @@ pub fn setup_frames(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>, mu
 
 /// Gives every window and source box a frame, and keeps its size; the focused window's
 /// frame is lighter.
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::type_complexity)]
 pub fn update_frames(
     mut commands: Commands,
@@ -135,6 +137,8 @@ pub fn update_frames(
 
 /// Draws a cross at every view of every marker and of the 3D pointer
 /// ([`super::markers::MarkerViews`]), redrawn when they change.
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::type_complexity)]
 pub fn update_crosses(
     mut commands: Commands,

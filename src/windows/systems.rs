@@ -17,6 +17,8 @@ use crate::region::Ray;
 
 /// Keeps user- and dataset-attached windows at their offset from the viewer or the
 /// dataset (room windows stay where they are).
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::type_complexity)]
 pub fn attach_windows(
     mut windows: Query<(&VolumeWindow, &mut Transform, &mut GlobalTransform), (Without<Viewer>, Without<Dataset>)>,
@@ -47,6 +49,8 @@ pub fn window_box(w: &VolumeWindow, global: &GlobalTransform) -> OrientedBox {
 }
 
 /// Turns every window into regions and cuts clip windows out of the datasets.
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::type_complexity)]
 pub fn window_regions(
     windows: Query<(Entity, &VolumeWindow, &GlobalTransform)>,
@@ -158,6 +162,8 @@ pub fn update_focus(
 
 /// Places every marker and the pointer in every view that shows their point
 /// ([`super::markers::views`]).
+// A Bevy system: its parameters are the resources and queries it uses, and a query's
+// type names the components it reads; splitting them up would only hide that.
 #[allow(clippy::type_complexity)]
 pub fn propagate_markers(
     mut commands: Commands,

@@ -1,4 +1,5 @@
 //! Helpers shared by the integration tests.
+// Each test crate uses some of these helpers, none uses all of them.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};

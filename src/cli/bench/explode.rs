@@ -82,7 +82,7 @@ pub fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32, only: &[us
         }
         let (loaded, motions) = &configs[(i - 1) / 2];
         let parts = replace_explosion(world, e, Some(loaded));
-        if i % 2 == 0 {
+        if i.is_multiple_of(2) {
             // (By the spec's order: despawned entities are reused, so entity order
             // shuffled the motions among the parts from the second round on.)
             for (p, m) in parts.into_iter().zip(motions) {

@@ -196,7 +196,8 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
             let mut data = Vec::new();
             for (i, file) in files.iter().enumerate() {
                 let want = if i + 1 == files.len() { len - per_file * i } else { per_file };
-                let chunk = read_chunk(path, file.as_deref(), &mut reader, compression, line_skip, byte_skip, want, options)?;
+                let layout = ChunkLayout { compression, line_skip, byte_skip, len: want };
+                let chunk = read_chunk(path, file.as_deref(), &mut reader, &layout, options)?;
                 if data.is_empty() { data = chunk } else { data.extend_from_slice(&chunk) }
             }
             encode(data, ty, order).map_err(fail)?
@@ -292,16 +293,24 @@ fn data_files(path: &Path, header: &Header) -> Result<Vec<Option<PathBuf>>, Prob
     Ok(vec![resolve(spec)])
 }
 
-fn read_chunk(
-    header_path: &Path,
-    file: Option<&Path>,
-    attached: &mut impl Read,
+/// How one file's samples are stored: compressed or not, after how many lines and bytes
+/// (`byte_skip` −1: the data ends the file), and how many bytes they take.
+struct ChunkLayout {
     compression: Compression,
     line_skip: u64,
     byte_skip: i64,
     len: usize,
+}
+
+/// Reads one data file's samples (`file`, or the bytes after the header in `attached`).
+fn read_chunk(
+    header_path: &Path,
+    file: Option<&Path>,
+    attached: &mut impl Read,
+    layout: &ChunkLayout,
     options: &ReadOptions,
 ) -> Result<Vec<u8>, ReadError> {
+    let &ChunkLayout { compression, line_skip, byte_skip, len } = layout;
     let at = file.unwrap_or(header_path);
     let fail = |p: Problem| ReadError::new(at, p);
     let mut own;

@@ -329,20 +329,20 @@ impl Decode<'_> {
             }
             "binary" => {
                 let text: String = array.text.chars().filter(|c| !c.is_whitespace()).collect();
-                self.from_base64(text.as_bytes(), len)
+                self.decode_base64(text.as_bytes(), len)
             }
             "appended" => {
                 let data = self.appended.ok_or_else(|| Problem::Malformed("appended array but no AppendedData".into()))?;
                 let offset = array.offset.ok_or_else(|| Problem::Malformed("appended array has no offset".into()))?;
                 let data = data.get(offset..).ok_or_else(|| Problem::Truncated(format!("appended data ends before offset {offset}")))?;
-                if self.appended_base64 { self.from_base64(data, len) } else { self.from_binary(data, len) }
+                if self.appended_base64 { self.decode_base64(data, len) } else { self.decode_binary(data, len) }
             }
             other => Err(Problem::Unsupported(format!("DataArray format '{other}'"))),
         }
     }
 
     /// Header and data in raw bytes.
-    fn from_binary(&self, data: &[u8], len: usize) -> Result<Vec<u8>, Problem> {
+    fn decode_binary(&self, data: &[u8], len: usize) -> Result<Vec<u8>, Problem> {
         let hs = self.header_size;
         let need = |n: usize| data.get(..n).ok_or_else(|| Problem::Truncated("data ends inside an array header".into()));
         if !self.compressed {
@@ -366,7 +366,7 @@ impl Decode<'_> {
     }
 
     /// Header and data in base64 (VTK encodes the header and the data separately).
-    fn from_base64(&self, text: &[u8], len: usize) -> Result<Vec<u8>, Problem> {
+    fn decode_base64(&self, text: &[u8], len: usize) -> Result<Vec<u8>, Problem> {
         let hs = self.header_size;
         let b64 = |t: &[u8]| STANDARD.decode(t).map_err(|e| Problem::Corrupt(format!("base64: {e}")));
         let chars = |bytes: usize| bytes.div_ceil(3) * 4;

@@ -39,6 +39,15 @@ pub fn meta_start(bytes: &[u8]) -> Result<(usize, bool), Problem> {
     }
 }
 
+/// One element header: tag, VR (if explicit), length (`None`: undefined) and where the
+/// value starts.
+struct Header {
+    tag: Tag,
+    vr: Option<[u8; 2]>,
+    len: Option<u32>,
+    value_at: usize,
+}
+
 /// Checks the whole file; returns the transfer syntax UID.
 pub fn check(bytes: &[u8]) -> Result<String, Problem> {
     let (start, _) = meta_start(bytes)?;
@@ -47,7 +56,7 @@ pub fn check(bytes: &[u8]) -> Result<String, Problem> {
     // Meta group: group 0002 elements.
     let mut ts = None;
     while w.pos + 4 <= bytes.len() && w.u16_at(w.pos) == 0x0002 {
-        let (tag, _, len, value_at) = w.header()?;
+        let Header { tag, len, value_at, .. } = w.header()?;
         let len = len.ok_or_else(|| Problem::Malformed("undefined length in the file meta group".into()))?;
         w.ensure(value_at, len as usize, tag)?;
         if tag == (0x0002, 0x0010) {
@@ -104,9 +113,8 @@ impl Walker<'_> {
         Ok(())
     }
 
-    /// Reads one element header at `pos`: tag, VR (if explicit), length (None =
-    /// undefined) and where the value starts.
-    fn header(&self) -> Result<(Tag, Option<[u8; 2]>, Option<u32>, usize), Problem> {
+    /// Reads the element header at `pos`.
+    fn header(&self) -> Result<Header, Problem> {
         let p = self.pos;
         self.need(p, 8)?;
         let group = self.u16_at(p);
@@ -127,7 +135,7 @@ impl Walker<'_> {
         } else {
             (None, self.u32_at(p + 4), p + 8)
         };
-        Ok((tag, vr, (len != UNDEFINED).then_some(len), value_at))
+        Ok(Header { tag, vr, len: (len != UNDEFINED).then_some(len), value_at })
     }
 
     /// Walks elements until `end` (exclusive) or a delimiter at this level.
@@ -144,7 +152,7 @@ impl Walker<'_> {
                 }
                 return Err(Problem::Truncated(format!("{} stray bytes at the end of a data set", end - self.pos)));
             }
-            let (tag, vr, len, value_at) = self.header()?;
+            let Header { tag, vr, len, value_at } = self.header()?;
             match (tag, len) {
                 // Item / sequence delimiters end the current undefined-length level.
                 ((0xFFFE, 0xE00D), _) | ((0xFFFE, 0xE0DD), _) => {
