@@ -23,7 +23,7 @@
 // HAS_SELECTION (opacity weighted by a selection: exploded views, focal::selection),
 // HAS_HOLES (regions with holes: clip windows; that code cost every region of every
 // ray on llvmpipe, 40 % of an exploded view's interval time, holes or not), HAS_TWO_LEVEL (segmented regions: each sample's object has its own mode,
-// src/twolevel).
+// src/region/appearance.rs, src/twolevel).
 //
 // llvmpipe, which CI and headless runs use, runs SIMD lanes in lockstep and executes
 // code under a divergent branch for every lane, so what costs here is code in the march
@@ -254,7 +254,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                     if kk > k_end || acc.a >= stop {
                         break;
                     }
-                    // Bricks where no part draws (twolevel::Segmentation::brick_occupancy)
+                    // Bricks where no part draws (region::Segmentation::brick_occupancy)
                     // are crossed as DVR crosses empty bricks; the open segment ends there.
                     if occupancy {
                         let before_skip = kk;

@@ -1,11 +1,15 @@
 //! Focal: a focus+context volume explorer.
 //!
-//! The crate is organised by technique (see `../shared/DESIGN.md` and the README):
-//! [`volume`] holds the data model, readers and phantoms; [`transfer`] the transfer
-//! functions; [`region`] the geometry every renderer shares; [`lens`] the magic volume lenses; [`context`] context-preserving rendering; [`clip`] clip planes and boxes; [`twolevel`] two-level rendering of segmented data; [`windows`] volumetric windows; [`explode`] exploded views; [`reference`] the CPU
-//! reference renderer; [`dataset`] the dataset entities that become regions; [`render`]
-//! the GPU ray caster that packs and draws them; [`scene`] scene files; [`ui`] the
-//! desktop app.
+//! The crate is organised by technique (see `../shared/DESIGN.md`, the README and
+//! `docs/architecture.md`, which gives the order in which the folders may know each
+//! other): [`volume`] holds the data model, readers and phantoms; [`transfer`] the
+//! transfer functions; [`context`] context-preserving rendering's equations;
+//! [`region`] what every renderer sees (geometry, cameras, looks and their scene form);
+//! [`clip`] clip planes and boxes; [`twolevel`] two-level rendering of segmented data;
+//! [`dataset`] the dataset entities that become regions and the volume views; [`lens`]
+//! the magic volume lenses; [`reference`] the CPU reference renderer; [`windows`]
+//! volumetric windows; [`explode`] exploded views; [`render`] the GPU ray caster that
+//! packs and draws them; [`scene`] scene files; [`ui`] the desktop app.
 
 pub mod clip;
 pub mod context;

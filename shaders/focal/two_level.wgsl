@@ -1,6 +1,6 @@
 #define_import_path focal::two_level
 
-// Two-level rendering in the march (src/twolevel; reference: trace::State::part and
+// Two-level rendering in the march (src/region/appearance.rs; reference: trace::State::part and
 // trace::Gathered): the segment of a segmented region the ray is in, what it has
 // gathered, and one sample of it by its part's mode.
 
@@ -15,7 +15,7 @@
 #import focal::samples::{is_projection, projected, dvr_classified, iso_surface, iso_hit}
 
 #ifdef HAS_TWO_LEVEL
-// Two-level rendering (src/twolevel): the segment of a segmented region the ray is in
+// Two-level rendering (src/region/appearance.rs): the segment of a segmented region the ray is in
 // and what it has gathered (reference: trace::State::part and trace::Gathered).
 const NO_PART: u32 = 0xffffffffu;
 
@@ -37,7 +37,7 @@ fn fresh(part: u32) -> Open {
 
 // The part (object, or the rest: the last part) of a sample of segmented region r at
 // world point p with normalised value v: the first candidate object of its label code
-// whose value range holds v (reference: twolevel::ObjectTable::object). `labels` is
+// whose value range holds v (reference: region::ObjectTable::object). `labels` is
 // r's label record.
 fn part_of(r: Region, labels: Region, p: vec3<f32>, v: f32) -> u32 {
     let code = nearest_code(labels, to_voxel(labels, p));

@@ -79,8 +79,9 @@ pub fn drawn_part(region: Region, look: &Appearance, volume: &Volume) -> Option<
 }
 
 /// The order of points along a Z-order (Morton) curve through their bounding box, 10
-/// bits an axis: parts drawn in this order put neighbours in the same run of
-/// [`crate::render::gpu_types::CLUSTER`] regions, whose sphere the ray tests first.
+/// bits an axis: parts drawn in this order are neighbours in the list of regions, so a
+/// renderer that tests runs of consecutive regions behind one bounding sphere (the GPU
+/// ray caster does) finds them compact.
 pub fn spatial_order(points: &[Vec3]) -> Vec<usize> {
     let lo = points.iter().copied().fold(Vec3::splat(f32::INFINITY), Vec3::min);
     let hi = points.iter().copied().fold(Vec3::splat(f32::NEG_INFINITY), Vec3::max);

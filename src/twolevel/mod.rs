@@ -29,7 +29,7 @@
 //! cannot live apart). This folder holds what is two-level rendering's alone: [`spec`],
 //! how scene files name objects (label codes, names matched in the label table, value
 //! ranges) and how they are resolved against the label volume. The CPU reference
-//! ([`crate::reference::trace`]) and the shader (`shaders/focal/two_level.wgsl`)
+//! (`reference::trace`) and the shader (`shaders/focal/two_level.wgsl`)
 //! implement the compositing.
 //!
 //! [`Segmentation`]: crate::region::Segmentation

@@ -219,7 +219,6 @@ fn screenshot_path() -> PathBuf {
     dir.join(format!("screenshot-{stamp}.png"))
 }
 
-/// Frames newly loaded data.
 /// Places the camera on newly loaded data: a scene's own camera, else an oblique view.
 fn reframe(mut session: ResMut<Session>, mut cams: Query<(&mut OrbitCamera, &Camera), With<MainCamera>>) {
     let Ok((mut orbit, camera)) = cams.single_mut() else { return };

@@ -7,16 +7,28 @@
 //! it names a path into it:
 //! - in a `use` statement (trees such as `use crate::a::{b, c::{d, e as f}}` expanded);
 //! - inline, as `crate::…`, `super::…`, `self::…`, `focal::…` (the library, from the
-//!   binary), a child module's name, or a module brought in by a `use`.
+//!   binary), a child module's name, or a module brought in by a `use` (also in a later
+//!   `use`: `use crate::lens; use lens::stack::Screen;`);
+//! - as a glob (`use x::*`): the module itself, and what it binds that the code names;
+//! - as the type of an inherent `impl` block (a method added to a type elsewhere is a
+//!   dependency no path shows where the method is called: such impls are listed, so a
+//!   check can keep them in their type's folder).
 //!
+//! Inline modules (`mod name { … }`) resolve `super` and `self` from their own path.
 //! A path goes to the longest module prefix that is a file; a name that module binds by
 //! a `use` (a re-export `pub use x::Item`, or a private import its children reach
 //! through `super::`) is followed to where the item comes from, so using an item
 //! through a folder's `mod.rs` is an edge to the file that defines it, not to the
-//! facade. A `pub use` is not an edge of its own unless the file's code also names the
-//! item. Edges into the crate roots are kept (the plugin groups live there).
+//! facade. A `pub use` is an edge of its own only when the file's code also names the
+//! item or it reaches into another folder (re-exporting what sits above is knowing it).
+//! Edges into the crate roots are kept (the plugin groups live there). Visibility paths
+//! (`pub(in crate::a)`) name no dependency.
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
+
+use super::source::{
+    code_only, expand, inherent_impls, inline_paths, mentions, scopes, use_statements, without_use_statements, without_visibility_paths,
+};
 
 /// A module: the crate it belongs to and its path in it (`[]` is the root).
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -49,73 +61,155 @@ pub struct Graph {
     /// Module → its file, relative to `src/`.
     pub files: BTreeMap<Module, String>,
     pub edges: BTreeMap<Module, Vec<Edge>>,
+    /// Inherent `impl` blocks of a type another folder defines: the file, the type's
+    /// file, the impl as written.
+    pub foreign_impls: Vec<(Module, Module, String)>,
 }
 
-/// A `use` item: whether it is `pub`, where it points and the name it binds.
+/// A `use` item: whether it is `pub`, where it points and the name it binds (`*` for a
+/// glob, whose `path` is then the module it reads).
 struct UseItem {
     public: bool,
     path: Module,
     name: String,
 }
 
+/// One module's text: a file's own, or an inline module's, with its uses.
+struct Part {
+    file: Module,
+    scope: Module,
+    body: String,
+    uses: Vec<UseItem>,
+}
+
 impl Graph {
-    /// The graph of `sources` (path relative to `src/`, text).
+    /// The graph of `sources` (path relative to `src/`, text). Files declared as test
+    /// modules (`#[cfg(test)] mod tests;`) and everything under them are left out.
     pub fn of(sources: &[(String, String)]) -> Graph {
         let mut graph = Graph::default();
         let mut texts = BTreeMap::new();
+        let mut test_modules = Vec::new();
         for (rel, text) in sources {
             let Some(module) = module_of(rel) else { continue };
+            let (code, tests) = code_only(text);
+            test_modules.extend(tests.iter().map(|t| child(&module, t)));
             graph.files.insert(module.clone(), rel.clone());
-            texts.insert(module, code_only(text));
+            texts.insert(module, code);
         }
-        let mut uses: BTreeMap<Module, Vec<UseItem>> = BTreeMap::new();
+        let is_test = |m: &Module| test_modules.iter().any(|t| t.bin == m.bin && m.path.starts_with(&t.path));
+        graph.files.retain(|m, _| !is_test(m));
+        texts.retain(|m, _| !is_test(m));
+        let mut parts = Vec::new();
         let mut bindings: HashMap<Module, HashMap<String, Module>> = HashMap::new();
-        for (module, text) in &texts {
-            let mut items = Vec::new();
-            for s in use_statements(text) {
-                for (p, alias) in expand(&text[s.tree.clone()]) {
-                    let (Some(name), Some(path)) = (alias.or_else(|| p.last().cloned()), graph.absolute(module, &p)) else { continue };
-                    items.push(UseItem { public: s.public, path, name });
+        for (file, text) in &texts {
+            for scope in scopes(text) {
+                let module = Module { bin: file.bin, path: [file.path.clone(), scope.below].concat() };
+                let uses = graph.use_items(&module, &scope.text);
+                for u in uses.iter().filter(|u| u.name != "*") {
+                    bindings.entry(module.clone()).or_default().insert(u.name.clone(), u.path.clone());
+                }
+                let body = without_visibility_paths(&without_use_statements(&scope.text));
+                parts.push(Part { file: file.clone(), scope: module, body, uses });
+            }
+        }
+        let mut edges: BTreeMap<Module, Vec<Edge>> = graph.files.keys().map(|m| (m.clone(), Vec::new())).collect();
+        let mut foreign_impls = Vec::new();
+        for part in &parts {
+            let out = edges.entry(part.file.clone()).or_default();
+            for (abs, via, impl_of) in graph.named_paths(part, &bindings) {
+                let Some(to) = graph.resolve(abs, &bindings) else { continue };
+                if impl_of && to.folder() != part.file.folder() {
+                    foreign_impls.push((part.file.clone(), to.clone(), via.clone()));
+                }
+                if to != part.file && !out.iter().any(|e| e.to == to) {
+                    out.push(Edge { to, via });
                 }
             }
-            for u in items.iter().filter(|u| u.name != "*") {
-                bindings.entry(module.clone()).or_default().insert(u.name.clone(), u.path.clone());
-            }
-            uses.insert(module.clone(), items);
         }
-        for (module, text) in &texts {
-            let body = without_use_statements(text);
-            let mut found: Vec<(Module, String)> = Vec::new();
-            // Modules bound by a `use`, for inline paths through them.
-            let mut bound: HashMap<&str, &Module> = HashMap::new();
-            for u in &uses[module] {
-                if u.public && !mentions(&body, &u.name) {
+        graph.edges = edges;
+        graph.foreign_impls = foreign_impls;
+        graph
+    }
+
+    /// The `use` items of one module's text, made absolute; a path that starts with a
+    /// name an earlier item binds (`use crate::lens; use lens::stack::Screen;`) goes
+    /// through it.
+    fn use_items(&self, module: &Module, text: &str) -> Vec<UseItem> {
+        let raw: Vec<(bool, Vec<String>, Option<String>)> = use_statements(text)
+            .into_iter()
+            .flat_map(|s| expand(&text[s.tree.clone()]).into_iter().map(move |(p, a)| (s.public, p, a)))
+            .collect();
+        let mut items: Vec<UseItem> = Vec::new();
+        let mut done = vec![false; raw.len()];
+        for _ in 0..4 {
+            for (k, (public, p, alias)) in raw.iter().enumerate() {
+                if done[k] {
                     continue;
                 }
-                found.push((u.path.clone(), u.path.path.join("::")));
-                if graph.files.contains_key(&u.path) {
-                    bound.insert(&u.name, &u.path);
+                let through = || {
+                    let m = &items.iter().find(|u| u.name == p[0] && u.name != "*")?.path;
+                    Some(Module { bin: m.bin, path: [m.path.clone(), p[1..].to_vec()].concat() })
+                };
+                let Some(mut path) = self.absolute(module, p).or_else(through) else { continue };
+                let glob = p.last().is_some_and(|l| l == "*");
+                if glob {
+                    path.path.pop();
                 }
+                let name = if glob { "*".to_string() } else { alias.clone().unwrap_or_else(|| p.last().cloned().unwrap_or_default()) };
+                items.push(UseItem { public: *public, path, name });
+                done[k] = true;
             }
-            for path in inline_paths(&body) {
-                let abs = graph.absolute(module, &path).or_else(|| {
-                    let m = bound.get(path[0].as_str())?;
-                    Some(Module { bin: m.bin, path: [m.path.clone(), path[1..].to_vec()].concat() })
-                });
-                if let Some(abs) = abs {
-                    found.push((abs, path.join("::")));
-                }
-            }
-            let mut edges: Vec<Edge> = Vec::new();
-            for (abs, via) in found {
-                let Some(to) = graph.resolve(abs, &bindings) else { continue };
-                if &to != module && !edges.iter().any(|e| e.to == to) {
-                    edges.push(Edge { to, via });
-                }
-            }
-            graph.edges.insert(module.clone(), edges);
         }
-        graph
+        items
+    }
+
+    /// Every path one module's code names, with how it was written and whether it is the
+    /// type of an inherent `impl`: its uses (a `pub use` only when the code names the
+    /// item or it reaches into another folder; a glob as its module and the names the
+    /// code takes from it), its inline paths, and its impls' types.
+    fn named_paths(&self, part: &Part, bindings: &HashMap<Module, HashMap<String, Module>>) -> Vec<(Module, String, bool)> {
+        let body = &part.body;
+        let mut found: Vec<(Module, String, bool)> = Vec::new();
+        let mut bound: HashMap<&str, &Module> = HashMap::new();
+        for u in &part.uses {
+            if u.name == "*" {
+                found.push((u.path.clone(), format!("{}::*", u.path.path.join("::")), false));
+                let file = self.resolve(u.path.clone(), bindings);
+                for (name, target) in file.as_ref().and_then(|f| bindings.get(f)).into_iter().flatten() {
+                    if mentions(body, name) {
+                        found.push((target.clone(), format!("{}::* ({name})", u.path.path.join("::")), false));
+                    }
+                }
+                continue;
+            }
+            let elsewhere = self.resolve(u.path.clone(), bindings).is_some_and(|t| t.folder() != part.file.folder());
+            if u.public && !mentions(body, &u.name) && !elsewhere {
+                continue;
+            }
+            found.push((u.path.clone(), u.path.path.join("::"), false));
+            if self.files.contains_key(&u.path) {
+                bound.insert(&u.name, &u.path);
+            }
+        }
+        let through_bound = |path: &[String]| {
+            let m = bound.get(path[0].as_str())?;
+            Some(Module { bin: m.bin, path: [m.path.clone(), path[1..].to_vec()].concat() })
+        };
+        for path in inline_paths(body) {
+            if let Some(abs) = self.absolute(&part.scope, &path).or_else(|| through_bound(&path)) {
+                found.push((abs, path.join("::"), false));
+            }
+        }
+        for path in inherent_impls(body) {
+            let abs = match path.as_slice() {
+                [name] => part.uses.iter().find(|u| &u.name == name).map(|u| u.path.clone()),
+                _ => self.absolute(&part.scope, &path).or_else(|| through_bound(&path)),
+            };
+            if let Some(abs) = abs {
+                found.push((abs, format!("impl {}", path.join("::")), true));
+            }
+        }
+        found
     }
 
     /// `path` as written in `module`, made absolute (`None` for paths into other crates).
@@ -190,273 +284,6 @@ fn module_of(rel: &str) -> Option<Module> {
         [first, ..] if first == "cli" => Some(Module { bin: true, path }),
         _ => Some(Module { bin: false, path }),
     }
-}
-
-/// Whether `word` occurs in `text` as a whole identifier.
-fn mentions(text: &str, word: &str) -> bool {
-    text.match_indices(word).any(|(i, _)| {
-        let before = text[..i].chars().next_back();
-        let after = text[i + word.len()..].chars().next();
-        !before.is_some_and(is_ident) && !after.is_some_and(is_ident)
-    })
-}
-
-fn is_ident(c: char) -> bool {
-    c.is_alphanumeric() || c == '_'
-}
-
-/// The text with comments, string and char literals blanked and `#[cfg(test)]` items
-/// (test modules, test-only `use`s) removed.
-pub fn code_only(text: &str) -> String {
-    let b: Vec<char> = text.chars().collect();
-    let mut out = String::with_capacity(text.len());
-    let mut i = 0;
-    while i < b.len() {
-        let c = b[i];
-        let next = b.get(i + 1).copied();
-        if c == '/' && next == Some('/') {
-            while i < b.len() && b[i] != '\n' {
-                i += 1;
-            }
-        } else if c == '/' && next == Some('*') {
-            let mut depth = 0;
-            while i < b.len() {
-                if b[i] == '/' && b.get(i + 1) == Some(&'*') {
-                    depth += 1;
-                    i += 2;
-                } else if b[i] == '*' && b.get(i + 1) == Some(&'/') {
-                    depth -= 1;
-                    i += 2;
-                    if depth == 0 {
-                        break;
-                    }
-                } else {
-                    i += 1;
-                }
-            }
-            out.push(' ');
-        } else if (c == 'r' || c == 'b') && !out.chars().next_back().is_some_and(is_ident) && raw_string_at(&b, i).is_some() {
-            i = raw_string_at(&b, i).unwrap_or(i + 1);
-            out.push_str("\"\"");
-        } else if c == '"' {
-            i += 1;
-            while i < b.len() && b[i] != '"' {
-                i += if b[i] == '\\' { 2 } else { 1 };
-            }
-            i += 1;
-            out.push_str("\"\"");
-        } else if c == '\'' {
-            // A char literal ('x', '\n', '\u{..}'); otherwise a lifetime.
-            if next == Some('\\') {
-                i += 2;
-                while i < b.len() && b[i] != '\'' {
-                    i += 1;
-                }
-                i += 1;
-                out.push_str("' '");
-            } else if b.get(i + 2) == Some(&'\'') {
-                i += 3;
-                out.push_str("' '");
-            } else {
-                out.push(c);
-                i += 1;
-            }
-        } else {
-            out.push(c);
-            i += 1;
-        }
-    }
-    remove_test_items(&out)
-}
-
-/// The end (exclusive) of a raw string literal starting at `i` (`r"…"`, `r#"…"#`,
-/// `br"…"`), if one starts there.
-fn raw_string_at(b: &[char], i: usize) -> Option<usize> {
-    let mut j = i;
-    if b[j] == 'b' {
-        j += 1;
-    }
-    if b.get(j) != Some(&'r') {
-        return None;
-    }
-    j += 1;
-    let mut hashes = 0;
-    while b.get(j) == Some(&'#') {
-        hashes += 1;
-        j += 1;
-    }
-    if b.get(j) != Some(&'"') {
-        return None;
-    }
-    j += 1;
-    while j < b.len() {
-        if b[j] == '"' && (1..=hashes).all(|k| b.get(j + k) == Some(&'#')) {
-            return Some(j + 1 + hashes);
-        }
-        j += 1;
-    }
-    Some(b.len())
-}
-
-/// Removes each `#[cfg(test)]` item: a `mod … { … }` block or a `use …;` statement.
-fn remove_test_items(text: &str) -> String {
-    let mut out = String::new();
-    let mut rest = text;
-    while let Some(at) = rest.find("#[cfg(test)]") {
-        out.push_str(&rest[..at]);
-        let after = &rest[at + "#[cfg(test)]".len()..];
-        let trimmed = after.trim_start();
-        let skip = after.len() - trimmed.len();
-        let end = if trimmed.starts_with("mod ") || trimmed.starts_with("pub mod ") {
-            match (trimmed.find('{'), trimmed.find(';')) {
-                (Some(open), semi) if semi.is_none_or(|s| open < s) => matching_brace(trimmed, open).map(|e| e + 1),
-                (_, Some(semi)) => Some(semi + 1),
-                _ => None,
-            }
-        } else if trimmed.starts_with("use ") {
-            trimmed.find(';').map(|s| s + 1)
-        } else {
-            Some(0)
-        };
-        let end = end.unwrap_or(trimmed.len());
-        rest = &after[skip + end..];
-    }
-    out.push_str(rest);
-    out
-}
-
-fn matching_brace(text: &str, open: usize) -> Option<usize> {
-    let mut depth = 0;
-    for (i, c) in text[open..].char_indices() {
-        match c {
-            '{' => depth += 1,
-            '}' => {
-                depth -= 1;
-                if depth == 0 {
-                    return Some(open + i);
-                }
-            }
-            _ => {}
-        }
-    }
-    None
-}
-
-/// A `use` statement: whether it is `pub` (any visibility), where its tree is in the
-/// text, and where the whole statement is.
-struct UseStatement {
-    public: bool,
-    tree: std::ops::Range<usize>,
-    whole: std::ops::Range<usize>,
-}
-
-/// Every `use` statement of a text (without comments and strings).
-fn use_statements(text: &str) -> Vec<UseStatement> {
-    let mut out = Vec::new();
-    for (i, _) in text.match_indices("use") {
-        let before = text[..i].chars().next_back();
-        let after = text[i + 3..].chars().next();
-        if before.is_some_and(|c| is_ident(c) || c == ':') || !after.is_some_and(char::is_whitespace) {
-            continue;
-        }
-        let Some(end) = text[i..].find(';').map(|e| i + e) else { continue };
-        let prefix = text[..i].trim_end();
-        let line = &prefix[prefix.rfind('\n').map_or(0, |n| n + 1)..];
-        let public = line.ends_with("pub") || (line.ends_with(')') && line.contains("pub("));
-        out.push(UseStatement { public, tree: i + 3..end, whole: i..end + 1 });
-    }
-    out
-}
-
-/// The text with its `use` statements blanked.
-fn without_use_statements(text: &str) -> String {
-    let mut out = text.to_string();
-    for s in use_statements(text).into_iter().rev() {
-        out.replace_range(s.whole, " ");
-    }
-    out
-}
-
-/// The paths of a use tree, each with the alias it is bound to (`as`), if any.
-pub fn expand(tree: &str) -> Vec<(Vec<String>, Option<String>)> {
-    let tree: String = tree.split_whitespace().collect::<Vec<_>>().join(" ");
-    let mut out = Vec::new();
-    expand_into(&[], &tree, &mut out);
-    out
-}
-
-fn expand_into(prefix: &[String], tree: &str, out: &mut Vec<(Vec<String>, Option<String>)>) {
-    let mut depth = 0;
-    let mut start = 0;
-    let mut items = Vec::new();
-    for (i, c) in tree.char_indices() {
-        match c {
-            '{' => depth += 1,
-            '}' => depth -= 1,
-            ',' if depth == 0 => {
-                items.push(&tree[start..i]);
-                start = i + 1;
-            }
-            _ => {}
-        }
-    }
-    items.push(&tree[start..]);
-    for item in items.into_iter().map(str::trim).filter(|s| !s.is_empty()) {
-        if let (Some(open), Some(close)) = (item.find('{'), item.rfind('}')) {
-            let head = segments(item[..open].trim_end_matches(|c: char| c == ':' || c.is_whitespace()));
-            expand_into(&[prefix.to_vec(), head].concat(), &item[open + 1..close], out);
-        } else {
-            let (path, alias) = match item.split_once(" as ") {
-                Some((p, a)) => (p, Some(a.trim().to_string())),
-                None => (item, None),
-            };
-            let path = [prefix.to_vec(), segments(path)].concat();
-            match path.last().map(String::as_str) {
-                // `use a::b::{self}` binds `b`.
-                Some("self") => out.push((path[..path.len() - 1].to_vec(), alias)),
-                Some(_) => out.push((path, alias)),
-                None => {}
-            }
-        }
-    }
-}
-
-fn segments(path: &str) -> Vec<String> {
-    path.split("::").map(str::trim).filter(|s| !s.is_empty()).map(String::from).collect()
-}
-
-/// Paths written in code: runs of identifiers joined by `::` (at least two segments),
-/// not preceded by `::` themselves.
-fn inline_paths(text: &str) -> Vec<Vec<String>> {
-    let b: Vec<char> = text.chars().collect();
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        let starts = is_ident(b[i]) && !b[i].is_ascii_digit() && (i == 0 || !(is_ident(b[i - 1]) || b[i - 1] == ':'));
-        if !starts {
-            i += 1;
-            continue;
-        }
-        let mut path = Vec::new();
-        let mut j = i;
-        loop {
-            let s = j;
-            while j < b.len() && is_ident(b[j]) {
-                j += 1;
-            }
-            path.push(b[s..j].iter().collect::<String>());
-            if b.get(j) == Some(&':') && b.get(j + 1) == Some(&':') && b.get(j + 2).is_some_and(|c| is_ident(*c)) {
-                j += 2;
-            } else {
-                break;
-            }
-        }
-        if path.len() > 1 {
-            out.push(path);
-        }
-        i = j.max(i + 1);
-    }
-    out
 }
 
 /// Tarjan's strongly connected components of a graph given by successor lists.

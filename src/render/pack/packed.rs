@@ -1,4 +1,5 @@
-//! The GPU layout of a packed scene: what [`super::pack`] fills and the upload sends.
+//! The GPU layout of a packed scene: what [`crate::render::pack::pack`] fills and the
+//! upload sends.
 
 use glam::{UVec3, Vec4};
 
@@ -31,17 +32,17 @@ pub struct PackedScene {
     /// Regions left out, with the reason (the atlas is full).
     pub dropped: Vec<String>,
     /// Per entry of `volumes`: the scene volume whose codes fill the second channel of
-    /// its texels (a selection's degree of interest, [`doi_channels`]).
+    /// its texels (a selection's degree of interest, [`crate::render::pack::doi_channels`]).
     pub doi_channels: Vec<Option<usize>>,
     /// Index in `regions` of every scene region (`None` for those dropped).
     pub region_slots: Vec<Option<u32>>,
     /// Regions the ray traverses: the first `region_count` of `regions` (the others
-    /// are records: the regions drawn in others' samples ([`companions`]), the parts and
+    /// are records: the regions drawn in others' samples ([`crate::render::pack::companions`]), the parts and
     /// labels of segmentations, the selections of weights).
     pub region_count: u32,
-    /// Shader features the regions need ([`super::gpu_types::features`]).
+    /// Shader features the regions need ([`crate::render::gpu_types::features`]).
     pub features: u32,
-    /// Bound on the iterations of the ray caster's loops ([`march_bound`]).
+    /// Bound on the iterations of the ray caster's loops ([`crate::render::pack::march_bound`]).
     pub max_steps: u32,
 }
 
