@@ -35,6 +35,23 @@ ensure_lint_tools() {
   }
 }
 
+# The independent oracle of the OME-Zarr tests (tests/oracle/): zarr-python, numpy and
+# nibabel in a virtual environment outside the clone, never a dependency of Focal.
+FOCAL_ORACLE_VENV="${FOCAL_ORACLE_VENV:-$HOME/.cache/focal-oracle}"
+ensure_oracle() {
+  local py="$FOCAL_ORACLE_VENV/bin/python"
+  if ! "$py" -c "import zarr, numpy, nibabel, numcodecs" >/dev/null 2>&1; then
+    echo "installing the test oracle (zarr, numpy, nibabel) into $FOCAL_ORACLE_VENV" >&2
+    if ! python3 -m venv "$FOCAL_ORACLE_VENV" >&2 2>&1; then
+      # Debian's python3 without ensurepip: the venv module comes with python3-venv.
+      FOCAL_PACKAGES=(python3-venv) ensure_packages
+      python3 -m venv "$FOCAL_ORACLE_VENV" >&2
+    fi
+    "$py" -m pip install --quiet --disable-pip-version-check "zarr>=3.1,<4" numpy nibabel numcodecs >&2
+  fi
+  export FOCAL_ORACLE_PYTHON="$py"
+}
+
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 ensure_packages
 

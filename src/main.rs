@@ -40,6 +40,8 @@ enum Command {
     Render(cli::render::RenderArgs),
     /// GPU frame times of fixed scenes, with ratios measured in the same run.
     Bench(cli::bench::BenchArgs),
+    /// Write a volume as a multiscale OME-Zarr pyramid.
+    Convert(cli::convert::ConvertArgs),
 }
 
 /// Whether a window can be opened (an X or Wayland display).
@@ -53,6 +55,7 @@ fn main() -> ExitCode {
         Some(Command::Info(a)) => cli::info::run(&a),
         Some(Command::Render(a)) => cli::render::run(&a),
         Some(Command::Bench(a)) => cli::bench::run(&a),
+        Some(Command::Convert(a)) => cli::convert::run(&a),
         None if args.headless || !has_display() => cli::render::run_headless(args.volume.as_deref(), &args.out),
         None => {
             let automation = args.screenshot.clone().zip(args.frames).map(|(p, n)| (n, p));

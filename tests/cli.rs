@@ -80,3 +80,35 @@ fn bench_explode_reports_table_1_as_percentages_of_the_plain_frame_rate() {
     assert_eq!(samples[0], 1.0);
     assert!(samples[4] > samples[3] && samples[3] >= 1.0, "{samples:?}");
 }
+
+#[test]
+fn convert_writes_a_pyramid_that_info_and_render_open() {
+    let dir = scratch("cli-convert");
+    let zarr = dir.join("fuel.ome.zarr");
+    let out = focal().arg("convert").arg(data("ct/fuel.nii.gz")).arg(&zarr).args(["--chunk", "16", "--zarr", "2"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(said.contains("3 levels (64×33×32, 32×17×16, 16×9×8), uint8"), "{said}");
+    assert!(zarr.join(".zattrs").is_file() && zarr.join("2/.zarray").is_file());
+    // A second run refuses to overwrite without --force.
+    let again = focal().arg("convert").arg(data("ct/fuel.nii.gz")).arg(&zarr).output().unwrap();
+    assert!(!again.status.success() && String::from_utf8_lossy(&again.stderr).contains("--force"));
+    let out = focal().args(["info", "--json"]).arg(&zarr).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["dimensions"], serde_json::json!([64, 33, 32]));
+    assert_eq!(v["format"], "OME-Zarr 0.4 (Zarr v2)");
+    assert_eq!(v["values"]["max"], 255.0);
+    let png = dir.join("fuel.png");
+    let out = focal().args(["render", "--cpu", "--size", "40x30", "--out"]).arg(&png).arg(&zarr).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&png).unwrap().to_rgba8();
+    assert!(img.pixels().any(|p| p[0] > 40), "the fuel shows");
+    // The procedural source: its finest level within the budget is read.
+    let out = focal().args(["info", "--json", "procedural:1024"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["dimensions"], serde_json::json!([512, 512, 512]));
+    let bad = focal().args(["info", "procedural:12x7"]).output().unwrap();
+    assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("NXxNYxNZ"));
+}

@@ -4,12 +4,15 @@ use std::path::PathBuf;
 
 use clap::Args;
 use focal::volume::readers::{RawSpec, ReadOptions, label_table, read_volume};
+use focal::volume::source::level::{WHOLE_LEVEL_BYTES, load_finest_within};
+use focal::volume::source::procedural::{DEFAULT_SPACING_MM, ProceduralSource, parse_dims};
 use focal::volume::{LabelTable, LabelVolume, Volume};
+use glam::Vec3;
 use serde_json::{Value, json};
 
 #[derive(Args)]
 pub struct InfoArgs {
-    /// Volume files or DICOM folders.
+    /// Volume files, DICOM or OME-Zarr folders, or `procedural:N[xNxN]`.
     #[arg(required = true)]
     files: Vec<PathBuf>,
     /// Print JSON (an array when several files are given).
@@ -28,13 +31,17 @@ pub fn run(args: &InfoArgs) -> Result<(), String> {
     let mut reports = Vec::new();
     let mut failures = Vec::new();
     for f in &args.files {
-        match read_volume(f, &options) {
+        let read = match f.to_string_lossy().strip_prefix("procedural:") {
+            Some(size) => procedural(size).map_err(|e| format!("{}: {e}", f.display())),
+            None => read_volume(f, &options).map_err(|e| e.to_string()),
+        };
+        match read {
             Ok(v) => {
                 let table = label_table::read_sidecars(f).map_err(|e| e.to_string())?;
                 let labels = (args.labels || !table.is_empty()).then(|| LabelVolume::from_volume(v.clone(), table)).transpose()?;
                 reports.push(report(&v, labels.as_ref()));
             }
-            Err(e) => failures.push(e.to_string()),
+            Err(e) => failures.push(e),
         }
     }
     if args.json {
@@ -46,6 +53,12 @@ pub fn run(args: &InfoArgs) -> Result<(), String> {
         }
     }
     if failures.is_empty() { Ok(()) } else { Err(failures.join("\nerror: ")) }
+}
+
+/// The procedural source of `size`, its finest level that fits the whole-level budget.
+fn procedural(size: &str) -> Result<Volume, String> {
+    let source = ProceduralSource::new(parse_dims(size)?, Vec3::splat(DEFAULT_SPACING_MM))?;
+    load_finest_within(&source, WHOLE_LEVEL_BYTES, &|_| {}).map_err(|e| e.to_string())
 }
 
 fn report(v: &Volume, labels: Option<&LabelVolume>) -> Value {

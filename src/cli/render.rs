@@ -10,11 +10,12 @@ use focal::region::{Mode, Shading, View};
 use focal::scene::file::{CameraSpec, DatasetSpec, RenderingSpec, SceneFile, SourceSpec};
 use focal::scene::run::{RunOptions, render_frames, render_scene_file};
 use focal::volume::phantom::Phantom;
+use focal::volume::source::procedural::{DEFAULT_SPACING_MM, parse_dims};
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene files (`.ron`), or one volume file, DICOM folder or `phantom:head|engine|sphere`
-    /// (default: the head phantom).
+    /// Scene files (`.ron`), or one volume file, DICOM or OME-Zarr folder,
+    /// `phantom:head|engine|sphere` or `procedural:N[xNxN]` (default: the head phantom).
     inputs: Vec<PathBuf>,
     /// Render on the CPU with the reference renderer instead of the GPU.
     #[arg(long)]
@@ -126,6 +127,10 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
         None => SourceSpec::Phantom { kind: Phantom::Head, resolution: args.resolution },
         Some(p) if p.to_string_lossy().starts_with("phantom:") => {
             SourceSpec::Phantom { kind: p.to_string_lossy()["phantom:".len()..].parse()?, resolution: args.resolution }
+        }
+        Some(p) if p.to_string_lossy().starts_with("procedural:") => {
+            let d = parse_dims(&p.to_string_lossy()["procedural:".len()..])?;
+            SourceSpec::Procedural { dims: (d.x, d.y, d.z), spacing_mm: DEFAULT_SPACING_MM }
         }
         Some(p) => match &args.raw {
             Some(layout) => SourceSpec::Raw { path: p.to_path_buf(), layout: layout.clone() },

@@ -117,6 +117,17 @@ pub enum SourceSpec {
     File(PathBuf),
     /// A headless raw file with its layout (`DIMS:TYPE[:le|be][:s=SPACING][:skip=N]`).
     Raw { path: PathBuf, layout: String },
+    /// The procedural gyroid ball of any size (voxels along x, y, z), for tests and
+    /// benchmarks at scale.
+    Procedural {
+        dims: (u32, u32, u32),
+        #[serde(default = "default_procedural_spacing")]
+        spacing_mm: f32,
+    },
+}
+
+fn default_procedural_spacing() -> f32 {
+    crate::volume::source::procedural::DEFAULT_SPACING_MM
 }
 
 /// A dataset in the scene.

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use glam::{Affine3A, EulerRot, Quat, Vec3};
+use glam::{Affine3A, EulerRot, Quat, UVec3, Vec3};
 
 use super::file::{CameraSpec, Change, DatasetSpec, SceneFile, SourceSpec, vec3};
 use crate::clip::Clipping;
@@ -13,6 +13,8 @@ use crate::transfer::presets;
 use crate::twolevel::spec::LabelSource;
 use crate::volume::phantom::head;
 use crate::volume::readers::{Progress, RawSpec, ReadOptions, label_table, read_volume};
+use crate::volume::source::level::{WHOLE_LEVEL_BYTES, load_finest_within};
+use crate::volume::source::procedural::ProceduralSource;
 use crate::volume::{LabelTable, LabelVolume, Volume};
 
 /// A dataset of a scene, loaded.
@@ -129,6 +131,10 @@ fn load_dataset(spec: &DatasetSpec, base: &Path, options: &ReadOptions) -> Resul
             let raw: RawSpec = layout.parse()?;
             let p = resolve(base, path);
             (read_volume(&p, &ReadOptions { raw: Some(raw), ..options.clone() }).map_err(|e| e.to_string())?, Some(p))
+        }
+        SourceSpec::Procedural { dims, spacing_mm } => {
+            let source = ProceduralSource::new(UVec3::new(dims.0, dims.1, dims.2), Vec3::splat(*spacing_mm))?;
+            (load_finest_within(&source, WHOLE_LEVEL_BYTES.min(options.max_bytes), &|_| {}).map_err(|e| e.to_string())?, None)
         }
     };
     match &spec.appearance.labels {

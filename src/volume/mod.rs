@@ -7,6 +7,7 @@
 //! volumes ([`SelectionVolume`], degree of interest 0..1) are volumes too.
 
 pub mod bricks;
+pub mod convert;
 pub mod encode;
 pub mod grid;
 pub mod labels;
@@ -16,6 +17,7 @@ pub mod readers;
 pub mod resample;
 pub mod sample;
 pub mod selection;
+pub mod source;
 pub mod stats;
 pub mod voxels;
 

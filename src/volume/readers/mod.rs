@@ -14,6 +14,7 @@ pub mod label_table;
 pub mod metaimage;
 pub mod nifti;
 pub mod nrrd;
+pub mod ome_zarr;
 pub mod raw;
 pub mod vti;
 
@@ -34,6 +35,7 @@ pub enum Format {
     MetaImage,
     Vti,
     VolvisDat,
+    OmeZarr,
     Raw,
 }
 
@@ -46,6 +48,7 @@ impl Format {
             Format::MetaImage => "MetaImage",
             Format::Vti => "VTK ImageData",
             Format::VolvisDat => "volvis .dat",
+            Format::OmeZarr => "OME-Zarr",
             Format::Raw => "raw",
         }
     }
@@ -56,6 +59,9 @@ pub const EXTENSIONS: &[&str] = &["nii", "gz", "hdr", "img", "dcm", "nrrd", "nhd
 
 /// Works out the format of `path` from its name, then from its first bytes.
 pub fn detect(path: &Path, options: &ReadOptions) -> Result<Format, ReadError> {
+    if ome_zarr::is_zarr(path) {
+        return Ok(Format::OmeZarr);
+    }
     if path.is_dir() {
         return Ok(Format::Dicom);
     }
@@ -101,7 +107,7 @@ pub fn detect(path: &Path, options: &ReadOptions) -> Result<Format, ReadError> {
             path,
             Problem::Unsupported(
                 "unknown file format (expected NIfTI, DICOM, NRRD, MetaImage, VTK .vti, volvis .dat, \
-                 or raw data with dimensions given by --raw)"
+                 an OME-Zarr folder, or raw data with dimensions given by --raw)"
                     .into(),
             ),
         ))
@@ -128,6 +134,7 @@ pub fn read_volume(path: &Path, options: &ReadOptions) -> Result<Volume, ReadErr
         Format::MetaImage => metaimage::read(path, options),
         Format::Vti => vti::read(path, options),
         Format::VolvisDat => dat::read(path, options),
+        Format::OmeZarr => ome_zarr::read(path, options),
         Format::Raw => match &options.raw {
             Some(spec) => raw::read(path, spec, options),
             None => Err(ReadError::new(path, Problem::Malformed("raw data needs dimensions and a sample type".into()))),

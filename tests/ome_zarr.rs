@@ -1,0 +1,268 @@
+//! OME-Zarr against independent tools: pyramids written by zarr-python (Zarr v2 and v3,
+//! NGFF 0.4 and 0.5, gzip, blosc, zstd, sharding) open with the values their formulas
+//! give; pyramids `focal convert` writes are checked by zarr-python, nibabel and numpy
+//! (tests/oracle/); chunks that are corrupt, absent or truncated and metadata that is
+//! wrong give messages naming them and a picture of the rest.
+//!
+//! The oracle runs in `$FOCAL_ORACLE_PYTHON` (scripts/test.sh provides one with zarr,
+//! numpy and nibabel), else in a `python3` that has them; with neither the tests say so
+//! and pass only when `FOCAL_ORACLE_PYTHON` is unset.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use common::{data, scratch};
+use focal::volume::convert::Downsample;
+use focal::volume::convert::ome_zarr::{WriteOptions, ZarrVersion, write};
+use focal::volume::readers::{ReadOptions, ome_zarr, read_volume};
+use focal::volume::source::level::read_level;
+use focal::volume::source::{FaultKind, VoxelSource};
+use glam::{UVec3, Vec3};
+
+/// The oracle's interpreter, if there is one.
+fn python() -> Option<PathBuf> {
+    if let Some(p) = std::env::var_os("FOCAL_ORACLE_PYTHON") {
+        return Some(PathBuf::from(p));
+    }
+    let ok = Command::new("python3").args(["-c", "import zarr, numpy, nibabel"]).status().is_ok_and(|s| s.success());
+    if ok {
+        Some(PathBuf::from("python3"))
+    } else {
+        eprintln!("note: no Python with zarr, numpy and nibabel (scripts/test.sh sets FOCAL_ORACLE_PYTHON): oracle skipped");
+        None
+    }
+}
+
+fn oracle(script: &str, args: &[&Path]) -> Option<String> {
+    let py = python()?;
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/oracle").join(script);
+    let out = Command::new(&py).arg(&script).args(args).output().expect("the oracle runs");
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "{} {:?} failed:\n{stdout}\n{}", script.display(), args, String::from_utf8_lossy(&out.stderr));
+    Some(stdout)
+}
+
+/// Pyramids written by zarr-python, once per test binary run.
+fn fixtures() -> Option<PathBuf> {
+    let dir = scratch("zarr-fixtures");
+    oracle("ome_zarr_make.py", &[&dir])?;
+    Some(dir)
+}
+
+/// Every voxel of every level of `source`, against `expected(level, x, y, z)`.
+fn check_levels(source: &dyn VoxelSource, tolerance: f64, expected: impl Fn(u32, u32, u32, u32) -> f64) {
+    let info = source.info();
+    for k in 0..info.levels.len() {
+        let (v, faults) = read_level(source, k, &|_| {}).expect("level reads");
+        assert!(faults.iter().all(|f| f.kind == FaultKind::Absent), "level {k}: {faults:?}");
+        let d = v.dims();
+        for z in 0..d.z {
+            for y in 0..d.y {
+                for x in 0..d.x {
+                    let f = 1 << k;
+                    let want = expected(k as u32, x * f, y * f, z * f);
+                    let got = v.real(x, y, z);
+                    assert!((got - want).abs() <= tolerance, "{}: level {k} voxel {x} {y} {z}: {got}, expected {want}", info.name);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn pyramids_written_by_zarr_python_open_with_their_values() {
+    let Some(dir) = fixtures() else { return };
+
+    // Zarr v2, uint16, gzip; micrometres become millimetres.
+    let s = ome_zarr::open(&dir.join("v2_uint16.ome.zarr")).expect("opens");
+    let info = s.info();
+    assert_eq!(info.levels.len(), 3);
+    assert_eq!(info.levels[0].grid.dims, UVec3::new(28, 24, 20));
+    assert_eq!(info.levels[0].grid.spacing, Vec3::new(0.0005, 0.0005, 0.002));
+    assert_eq!(info.levels[2].grid.dims, UVec3::new(7, 6, 5));
+    assert_eq!(info.levels[1].chunk, UVec3::splat(8));
+    assert!(info.source.format.contains("0.4") && info.source.format.contains("v2"), "{}", info.source.format);
+    check_levels(&s, 0.0, |_, x, y, z| ((x * 7 + y * 13 + z * 31) % 4096) as f64);
+
+    // Zarr v2, int16, blosc, "." keys, a translation, no unit (taken as millimetres).
+    let s = ome_zarr::open(&dir.join("v2_int16_blosc.ome.zarr")).expect("opens");
+    assert_eq!(s.info().levels[0].grid.origin, Vec3::new(7.0, 6.0, 5.0));
+    assert!(s.info().warnings.iter().any(|w| w.contains("no unit")), "{:?}", s.info().warnings);
+    check_levels(&s, 0.0, |_, x, y, z| x as f64 - 3.0 * y as f64 + 5.0 * z as f64 - 100.0);
+
+    // Zarr v3, float32, sharded, two channels: channel 0 shown, values quantised over
+    // the coarsest level's range (16 bits: within a step of the range).
+    let s = ome_zarr::open(&dir.join("v3_float32_sharded.ome.zarr")).expect("opens");
+    let info = s.info();
+    assert!(info.source.format.contains("0.5") && info.source.format.contains("v3"), "{}", info.source.format);
+    assert_eq!(info.levels[0].grid.dims, UVec3::new(24, 20, 16));
+    assert_eq!(info.levels[0].chunk, UVec3::splat(4), "the read unit is the inner chunk");
+    assert!(info.warnings.iter().any(|w| w.contains("\"c\" has 2 entries")), "{:?}", info.warnings);
+    let step = info.values.slope;
+    assert!(step > 0.0 && step < 1e-3, "quantisation step {step}");
+    // The coarsest level spans 0 .. 0.5·22 + 14 = 25 (x, z even), finer levels reach 26.5:
+    // values past the coarsest range clamp to it.
+    check_levels(&s, step, |_, x, y, z| (x as f64 * 0.5 - y as f64 * 0.25 + z as f64).clamp(-4.5, 25.0));
+
+    // Zarr v3, uint8, gzip, millimetres, a translation.
+    let s = ome_zarr::open(&dir.join("v3_uint8.ome.zarr")).expect("opens");
+    let g = &s.info().levels[0].grid;
+    assert_eq!((g.spacing, g.origin), (Vec3::new(0.75, 1.0, 1.5), Vec3::new(30.0, 20.0, -10.0)));
+    assert!(s.info().warnings.is_empty(), "{:?}", s.info().warnings);
+    check_levels(&s, 0.0, |_, x, y, z| ((x + 2 * y + 3 * z) % 256) as f64);
+
+    // The reader dispatch opens them as volumes (level 0 fits in memory).
+    let v = read_volume(&dir.join("v3_uint8.ome.zarr"), &ReadOptions::default()).expect("reads");
+    assert_eq!(v.dims(), UVec3::new(16, 14, 12));
+    // x + 2y + 3z at (3, 2, 1).
+    assert_eq!(v.real(3, 2, 1), 10.0);
+}
+
+/// Writes `src` with `focal convert`'s writer and checks it with the oracle.
+fn convert_and_check(src: &Path, out: &Path, opts: &WriteOptions) -> Option<String> {
+    let volume = read_volume(src, &ReadOptions::default()).expect("source reads");
+    write(&volume, out, opts, &|_, _| {}).expect("pyramid writes");
+    let labels = opts.downsample == Downsample::Nearest;
+    let mut args: Vec<&Path> = vec![src, out];
+    if labels {
+        args.push(Path::new("--labels"));
+    }
+    let line = oracle("ome_zarr_check.py", &args)?;
+    assert!(line.contains("\"ok\": true"), "{line}");
+    // And Focal reads it back to the same grid and values.
+    let back = ome_zarr::open(out).expect("reopens");
+    assert_eq!(back.info().levels[0].grid.dims, volume.dims());
+    let g = &back.info().levels[0].grid;
+    assert!((g.origin - volume.grid.origin).length() < 1e-3 && (g.spacing - volume.grid.spacing).length() < 1e-5);
+    assert!(g.direction.abs_diff_eq(volume.grid.direction, 1e-6));
+    let (l0, faults) = read_level(&back, 0, &|_| {}).expect("level 0");
+    assert!(faults.iter().all(|f| f.kind == FaultKind::Absent));
+    let d = volume.dims();
+    for (x, y, z) in [(0, 0, 0), (d.x - 1, d.y - 1, d.z - 1), (d.x / 2, d.y / 3, d.z / 2)] {
+        assert_eq!(l0.real(x, y, z), volume.real(x, y, z));
+    }
+    Some(line)
+}
+
+#[test]
+fn converted_pyramids_pass_the_independent_check() {
+    let dir = scratch("zarr-convert");
+    // uint8 CT, Zarr v3 sharded.
+    let shard = WriteOptions { chunk: 16, shard: Some(2), ..Default::default() };
+    let Some(line) = convert_and_check(&data("ct/fuel.nii.gz"), &dir.join("fuel.ome.zarr"), &shard) else { return };
+    assert!(line.contains("\"zarr_format\": 3") && line.contains("uint8"), "{line}");
+    // An MRI with odd dimensions (181 × 217 × 181), Zarr v2.
+    let v2 = WriteOptions { chunk: 32, version: ZarrVersion::V2, ..Default::default() };
+    let line = convert_and_check(&data("mri/ch2.nii.gz"), &dir.join("ch2.ome.zarr"), &v2).expect("oracle");
+    assert!(line.contains("\"levels\": 4") && line.contains("\"zarr_format\": 2"), "{line}");
+    // A label atlas: levels keep label ids (nearest).
+    let labels = WriteOptions { chunk: 64, downsample: Downsample::Nearest, ..Default::default() };
+    convert_and_check(&data("labels/aal.nii.gz"), &dir.join("aal.ome.zarr"), &labels).expect("oracle");
+    // Writing over a pyramid needs the overwrite flag; over anything else it is refused.
+    let volume = read_volume(&data("ct/fuel.nii.gz"), &ReadOptions::default()).expect("reads");
+    let again = write(&volume, &dir.join("fuel.ome.zarr"), &WriteOptions::default(), &|_, _| {}).expect_err("exists");
+    assert!(again.contains("--force"), "{again}");
+    let other = dir.join("not-zarr");
+    std::fs::create_dir_all(&other).expect("dir");
+    std::fs::write(other.join("notes.txt"), "keep me").expect("file");
+    let err = write(&volume, &other, &WriteOptions { overwrite: true, ..Default::default() }, &|_, _| {}).expect_err("refused");
+    assert!(err.contains("not a Zarr pyramid") && other.join("notes.txt").exists(), "{err}");
+}
+
+#[test]
+fn an_int16_volume_converts_exactly() {
+    // The EPI MRI is int16 with an odd depth (37): levels are exact means in int16.
+    let src = data("mri/epi_64x64x37.mha");
+    let volume = read_volume(&src, &ReadOptions::default()).expect("reads");
+    let dir = scratch("zarr-int16");
+    let out = dir.join("epi.ome.zarr");
+    let written = write(&volume, &out, &WriteOptions { chunk: 16, ..Default::default() }, &|_, _| {}).expect("writes");
+    assert_eq!(written.sample.name(), "int16");
+    assert_eq!(written.levels, vec![UVec3::new(64, 64, 37), UVec3::new(32, 32, 19), UVec3::new(16, 16, 10)]);
+    let back = ome_zarr::open(&out).expect("reopens");
+    // Level 1 voxel (3, 4, 18) is the rounded mean of level-0 x 6..7, y 8..9 and z 36
+    // (the odd last slice stands in for the missing one).
+    let (l1, _) = read_level(&back, 1, &|_| {}).expect("level 1");
+    let mut sum = 0.0;
+    for (x, y) in [(6, 8), (7, 8), (6, 9), (7, 9)] {
+        sum += 2.0 * volume.real(x, y, 36);
+    }
+    assert_eq!(l1.real(3, 4, 18), ((sum + 4.0) / 8.0).floor());
+}
+
+/// A copy of a fixture to damage.
+fn damaged(name: &str, fixture: &Path) -> PathBuf {
+    let dir = scratch(name);
+    let out = dir.join(fixture.file_name().expect("name"));
+    copy_dir(fixture, &out);
+    out
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("dir");
+    for e in std::fs::read_dir(from).expect("list") {
+        let e = e.expect("entry");
+        let target = to.join(e.file_name());
+        if e.path().is_dir() {
+            copy_dir(&e.path(), &target);
+        } else {
+            std::fs::copy(e.path(), target).expect("copy");
+        }
+    }
+}
+
+#[test]
+fn bad_chunks_and_metadata_are_named_and_the_rest_is_drawn() {
+    let Some(dir) = fixtures() else { return };
+    // A corrupt gzip chunk (v2): its key is named, the others read.
+    let p = damaged("zarr-corrupt", &dir.join("v2_uint16.ome.zarr"));
+    std::fs::write(p.join("0/1/1/1"), b"this is not gzip").expect("corrupt");
+    let s = ome_zarr::open(&p).expect("opens");
+    let b = s.read_box(0, UVec3::ZERO, UVec3::new(28, 24, 20)).expect("box");
+    let bad: Vec<_> = b.faults.iter().filter(|f| f.kind == FaultKind::Unreadable).collect();
+    assert_eq!(bad.len(), 1, "{:?}", b.faults);
+    assert_eq!(bad[0].chunk, "0/1/1/1");
+    // Outside the bad chunk, the values are right.
+    assert_eq!(b.voxels.code(0), 0);
+    let at = |x: u32, y: u32, z: u32| b.voxels.code(((z * 24 + y) * 28 + x) as usize) as u32;
+    // (7x + 13y + 31z) mod 4096 at (27, 23, 19): 189 + 299 + 589 = 1077.
+    assert_eq!(at(27, 23, 19), 1077);
+    assert_eq!(at(9, 9, 9), 0, "the corrupt chunk reads as the fill value");
+    // An absent chunk is the fill value, noted by its key.
+    std::fs::remove_file(p.join("0/0/0/0")).expect("remove");
+    let b = s.read_box(0, UVec3::ZERO, UVec3::splat(4)).expect("box");
+    assert_eq!(b.faults.len(), 1);
+    assert_eq!((b.faults[0].kind, b.faults[0].chunk.as_str()), (FaultKind::Absent, "0/0/0/0"));
+    // The volume read reports both as notes.
+    let v = ome_zarr::read(&p, &ReadOptions::default()).expect("reads");
+    let notes: Vec<&String> = v.source.details.iter().filter(|(k, _)| k == "note").map(|(_, n)| n).collect();
+    assert!(notes.iter().any(|n| n.contains("0/1/1/1")), "{notes:?}");
+    assert!(notes.iter().any(|n| n.contains("absent")), "{notes:?}");
+
+    // A truncated shard (v3): the inner chunks past the cut fail, the shard is named.
+    let p = damaged("zarr-truncated", &dir.join("v3_float32_sharded.ome.zarr"));
+    let shard = p.join("0/c/0/0/0/0");
+    let len = std::fs::metadata(&shard).expect("shard").len();
+    let file = std::fs::OpenOptions::new().write(true).open(&shard).expect("open");
+    file.set_len(len / 2).expect("truncate");
+    let s = ome_zarr::open(&p).expect("opens");
+    let b = s.read_box(0, UVec3::ZERO, UVec3::splat(8)).expect("box");
+    assert!(b.faults.iter().any(|f| f.kind == FaultKind::Unreadable && f.chunk.contains("c/0/0/0/0")), "{:?}", b.faults);
+
+    // Wrong metadata: the group and the problem are named.
+    let p = damaged("zarr-metadata", &dir.join("v3_uint8.ome.zarr"));
+    let text = std::fs::read_to_string(p.join("zarr.json")).expect("metadata");
+    std::fs::write(p.join("zarr.json"), text.replace("\"scale\": [", "\"scale\": [0.0, ")).expect("edit");
+    let err = ome_zarr::open(&p).map(|_| ()).expect_err("refused").to_string();
+    assert!(err.contains("v3_uint8.ome.zarr") && err.contains("scale"), "{err}");
+    std::fs::write(p.join("zarr.json"), "{ not json").expect("edit");
+    let err = ome_zarr::open(&p).map(|_| ()).expect_err("refused").to_string();
+    assert!(err.contains("v3_uint8.ome.zarr") && err.contains("zarr.json"), "{err}");
+    // A level whose array is missing.
+    let p = damaged("zarr-level", &dir.join("v2_int16_blosc.ome.zarr"));
+    std::fs::remove_dir_all(p.join("1")).expect("remove level");
+    let err = ome_zarr::open(&p).map(|_| ()).expect_err("refused").to_string();
+    assert!(err.contains("level 1"), "{err}");
+}
