@@ -13,7 +13,7 @@ mod cli;
 struct Args {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Volume file or DICOM folder to open (the built-in head phantom when omitted).
+    /// Volume file, DICOM or OME-Zarr folder to open (the built-in head phantom when omitted).
     volume: Option<PathBuf>,
     /// Where the run writes its picture when there is no display.
     #[arg(long, default_value = "out/focal.png")]

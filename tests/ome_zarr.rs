@@ -113,6 +113,18 @@ fn pyramids_written_by_zarr_python_open_with_their_values() {
     assert!(s.info().warnings.is_empty(), "{:?}", s.info().warnings);
     check_levels(&s, 0.0, |_, x, y, z| ((x + 2 * y + 3 * z) % 256) as f64);
 
+    // float32 with a display window: quantised over it; a NaN voxel is drawn at its low
+    // end and reported with its chunk.
+    let s = ome_zarr::open(&dir.join("v3_float32_nan.ome.zarr")).expect("opens");
+    assert_eq!((s.info().values.intercept, s.info().values.slope), (-100.0, 600.0 / 65535.0));
+    let b = s.read_box(0, UVec3::ZERO, UVec3::new(8, 6, 4)).expect("box");
+    let nan: Vec<_> = b.faults.iter().filter(|f| f.kind == FaultKind::NotFinite).collect();
+    assert_eq!(nan.len(), 1, "{:?}", b.faults);
+    assert_eq!(nan[0].chunk, "0/c/0/0/0", "z 1, y 2, x 3 lies in chunk (0, 0, 0) of 2×3×4");
+    let real = |x: u32, y: u32, z: u32| s.info().values.to_real(b.voxels.code(((z * 6 + y) * 8 + x) as usize) as f64);
+    assert_eq!(real(3, 2, 1), -100.0);
+    assert!((real(7, 5, 3) - 357.0).abs() <= s.info().values.slope);
+
     // The reader dispatch opens them as volumes (level 0 fits in memory).
     let v = read_volume(&dir.join("v3_uint8.ome.zarr"), &ReadOptions::default()).expect("reads");
     assert_eq!(v.dims(), UVec3::new(16, 14, 12));

@@ -16,6 +16,7 @@
 //! The renderer packs; it does not decide: what is drawn where is the techniques'
 //! business (datasets, windows, exploded parts), expressed as regions.
 
+pub mod bricked;
 pub mod extract;
 pub mod feature_pass;
 pub mod gpu_types;

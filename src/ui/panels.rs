@@ -101,7 +101,7 @@ pub fn ui(
                     state.dialog_purpose = DialogPurpose::Open;
                     state.dialog.pick_file();
                 }
-                if ui.button("Open DICOM folder…").clicked() {
+                if ui.button("Open DICOM or OME-Zarr folder…").clicked() {
                     state.dialog_purpose = DialogPurpose::Open;
                     state.dialog.pick_directory();
                 }

@@ -90,7 +90,16 @@ def main(out):
                     [1.5, 1.0, 0.75], [-10.0, 20.0, 30.0])
     write(out / "v3_uint8.ome.zarr", 3, levels(d, 3), {"ome": {"version": "0.5", "multiscales": [ms]}},
           chunks=(8, 8, 8), compressors=GzipCodec(level=5))
-    print(f"wrote 4 pyramids with zarr-python {zarr.__version__} into {out}")
+    # (e) Zarr v3, NGFF 0.5, float32 with a display window and one NaN voxel (z, y, x =
+    # 1, 2, 3), one level.
+    x, y, z = grid((4, 6, 8))
+    e = (x + 10 * y + 100 * z).astype(np.float32)
+    e[1, 2, 3] = np.nan
+    ms = multiscale(zyx, [1.0, 1.0, 1.0], n=1)
+    omero = {"channels": [{"window": {"min": -100.0, "max": 500.0, "start": 0.0, "end": 400.0}}]}
+    write(out / "v3_float32_nan.ome.zarr", 3, [e], {"ome": {"version": "0.5", "multiscales": [ms], "omero": omero}},
+          chunks=(2, 3, 4), compressors=ZstdCodec(level=3))
+    print(f"wrote 5 pyramids with zarr-python {zarr.__version__} into {out}")
 
 
 if __name__ == "__main__":

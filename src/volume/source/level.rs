@@ -84,12 +84,17 @@ pub fn load_finest_within(source: &dyn VoxelSource, max_bytes: u64, done: &(dyn 
     Ok(volume)
 }
 
-/// One line for a list of faults: the unreadable chunks (each named, up to five) and how
-/// many were absent.
+/// One line for a list of faults: the unreadable chunks (each named, up to five), the
+/// samples that were not finite and how many chunks were absent.
 pub fn summarize(faults: &[Fault]) -> Option<String> {
     let bad: Vec<&Fault> = faults.iter().filter(|f| f.kind == FaultKind::Unreadable).collect();
-    let absent = faults.len() - bad.len();
+    let absent = faults.iter().filter(|f| f.kind == FaultKind::Absent).count();
+    let not_finite: Vec<&Fault> = faults.iter().filter(|f| f.kind == FaultKind::NotFinite).collect();
     let mut parts = Vec::new();
+    if !not_finite.is_empty() {
+        let first = not_finite[0];
+        parts.push(format!("NaN or infinite samples in {} chunk(s) (chunk {}: {})", not_finite.len(), first.chunk, first.problem));
+    }
     if !bad.is_empty() {
         let named: Vec<String> = bad.iter().take(5).map(|f| format!("chunk {}: {}", f.chunk, f.problem)).collect();
         let more = if bad.len() > 5 { format!(" (and {} more)", bad.len() - 5) } else { String::new() };
@@ -147,8 +152,10 @@ mod tests {
         assert_eq!(finest_within(m.info(), 64 * 64 * 64 * 2 - 1), 1);
         assert_eq!(finest_within(m.info(), 1), 3);
         let f = |kind, chunk: &str| Fault { chunk: chunk.into(), kind, problem: "crc mismatch".into() };
-        let line = summarize(&[f(FaultKind::Unreadable, "0/1/2"), f(FaultKind::Absent, "0/0/0")]).expect("line");
+        let line =
+            summarize(&[f(FaultKind::Unreadable, "0/1/2"), f(FaultKind::Absent, "0/0/0"), f(FaultKind::NotFinite, "0/0/1")]).expect("line");
         assert!(line.contains("chunk 0/1/2: crc mismatch") && line.contains("1 chunk(s) absent"), "{line}");
+        assert!(line.contains("NaN or infinite samples in 1 chunk(s) (chunk 0/0/1"), "{line}");
         assert_eq!(summarize(&[]), None);
     }
 }

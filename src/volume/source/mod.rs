@@ -80,6 +80,8 @@ pub enum FaultKind {
     Absent,
     /// The chunk is there but could not be read or decoded.
     Unreadable,
+    /// The chunk was read, but some samples are NaN or infinite (drawn as code 0).
+    NotFinite,
 }
 
 /// Part of a box that could not be read.

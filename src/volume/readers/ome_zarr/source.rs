@@ -4,8 +4,8 @@
 //! Samples become codes under one map fixed on opening: `uint8` and `uint16` as they are,
 //! `int8` and `int16` shifted by 2⁷ or 2¹⁵ (lossless), wider and floating-point types
 //! quantised to 16 bits over the first channel's display window or, without one, over
-//! the range of the coarsest level (values past it clamp; the opening says so). NaN
-//! samples read as the window's low end.
+//! the range of the coarsest level (values past it clamp; the opening says so). NaN and
+//! infinite samples read as the window's low end and are reported per chunk.
 //!
 //! A box is read chunk by chunk (for a sharded array, only the inner chunks it touches
 //! are decoded). A chunk the store does not have is the array's fill value, as Zarr
@@ -25,6 +25,9 @@ use super::metadata::{AxisKind, Multiscale};
 use crate::volume::grid::{Grid, fmt_dims};
 use crate::volume::source::{Block, Fault, FaultKind, SourceError, SourceInfo, SourceLevel, VoxelSource, check_box};
 use crate::volume::{Source, ValueMap, Voxels};
+
+/// Largest box edge read to find the value range of a pyramid without a display window.
+const RANGE_BOX: u32 = 256;
 
 /// How samples become codes.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -222,9 +225,14 @@ impl ZarrSource {
             Some(w) => w,
             None => {
                 let coarsest = self.levels.len() - 1;
-                let (lo, hi) = self.native_range(coarsest, ty)?;
+                let (lo, hi, sampled) = self.native_range(coarsest, ty)?;
+                let of = if sampled {
+                    format!("the central {RANGE_BOX}³ voxels of the coarsest level")
+                } else {
+                    "the coarsest level".to_owned()
+                };
                 warnings.push(format!(
-                    "{dt} values quantised to 16 bits over [{lo}, {hi}], the range of the coarsest level (no display window in the metadata): finer values outside it clamp"
+                    "{dt} values quantised to 16 bits over [{lo}, {hi}], the range of {of} (no display window in the metadata): values outside it clamp"
                 ));
                 (lo, hi)
             }
@@ -233,10 +241,13 @@ impl ZarrSource {
         Ok((Encoding::Quantised { ty, lo, hi }, ValueMap::new((hi - lo) / 65535.0, lo), 16))
     }
 
-    /// The finite range of a whole level in its own type.
-    fn native_range(&self, level: usize, ty: Wide) -> Result<(f64, f64), String> {
+    /// The finite range of a level in its own type: the whole level, or its central
+    /// [`RANGE_BOX`]³ voxels when it is larger (`sampled` says so).
+    fn native_range(&self, level: usize, ty: Wide) -> Result<(f64, f64, bool), String> {
         let l = &self.levels[level];
-        let subset = l.subset(UVec3::ZERO, self.info.levels[level].grid.dims);
+        let dims = self.info.levels[level].grid.dims;
+        let size = dims.min(UVec3::splat(RANGE_BOX));
+        let subset = l.subset((dims - size) / 2, size);
         let values: Vec<f64> = match ty {
             Wide::U32 => retrieve::<u32>(l, &subset)?.into_iter().map(f64::from).collect(),
             Wide::I32 => retrieve::<i32>(l, &subset)?.into_iter().map(f64::from).collect(),
@@ -245,35 +256,40 @@ impl ZarrSource {
         };
         let finite = values.iter().copied().filter(|v| v.is_finite());
         let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
-        if lo > hi { Ok((0.0, 1.0)) } else { Ok((lo, hi)) }
+        let sampled = size != dims;
+        if lo > hi { Ok((0.0, 1.0, sampled)) } else { Ok((lo, hi, sampled)) }
     }
 
     /// Reads `subset` of a level, putting element `i` (in the subset's order) at
-    /// `out[targets[i]]`.
-    fn read_part(&self, l: &Level, subset: &ArraySubset, targets: &[usize], out: &mut [u16]) -> Result<(), String> {
+    /// `out[targets[i]]`; returns how many samples were NaN or infinite (drawn as code 0).
+    fn read_part(&self, l: &Level, subset: &ArraySubset, targets: &[usize], out: &mut [u16]) -> Result<usize, String> {
         fn put<T: ElementOwned + Copy>(
             l: &Level,
             subset: &ArraySubset,
             targets: &[usize],
             out: &mut [u16],
-            code: impl Fn(T) -> u16,
-        ) -> Result<(), String> {
+            code: impl Fn(T) -> Option<u16>,
+        ) -> Result<usize, String> {
             let v = retrieve::<T>(l, subset)?;
             if v.len() != targets.len() {
                 return Err(format!("{} values decoded for {} voxels", v.len(), targets.len()));
             }
+            let mut bad = 0;
             for (&at, &x) in targets.iter().zip(&v) {
-                out[at] = code(x);
+                out[at] = code(x).unwrap_or_else(|| {
+                    bad += 1;
+                    0
+                });
             }
-            Ok(())
+            Ok(bad)
         }
         match self.encoding {
-            Encoding::U8 => put(l, subset, targets, out, |x: u8| x as u16),
-            Encoding::I8 => put(l, subset, targets, out, |x: i8| (x as i16 + 128) as u16),
-            Encoding::U16 => put(l, subset, targets, out, |x: u16| x),
-            Encoding::I16 => put(l, subset, targets, out, |x: i16| (x as i32 + 32768) as u16),
+            Encoding::U8 => put(l, subset, targets, out, |x: u8| Some(x as u16)),
+            Encoding::I8 => put(l, subset, targets, out, |x: i8| Some((x as i16 + 128) as u16)),
+            Encoding::U16 => put(l, subset, targets, out, |x: u16| Some(x)),
+            Encoding::I16 => put(l, subset, targets, out, |x: i16| Some((x as i32 + 32768) as u16)),
             Encoding::Quantised { ty, lo, hi } => {
-                let q = move |x: f64| if x.is_finite() { ((x - lo) / (hi - lo) * 65535.0).round().clamp(0.0, 65535.0) as u16 } else { 0 };
+                let q = move |x: f64| x.is_finite().then(|| ((x - lo) / (hi - lo) * 65535.0).round().clamp(0.0, 65535.0) as u16);
                 match ty {
                     Wide::U32 => put(l, subset, targets, out, |x: u32| q(x as f64)),
                     Wide::I32 => put(l, subset, targets, out, |x: i32| q(x as f64)),
@@ -352,8 +368,14 @@ impl VoxelSource for ZarrSource {
                         });
                     }
                     let targets = l.targets(clo, chi - clo, lo, size);
-                    if let Err(e) = self.read_part(l, &part, &targets, &mut codes) {
-                        faults.push(Fault { chunk: key_name, kind: FaultKind::Unreadable, problem: e });
+                    match self.read_part(l, &part, &targets, &mut codes) {
+                        Ok(0) => {}
+                        Ok(n) => faults.push(Fault {
+                            chunk: key_name,
+                            kind: FaultKind::NotFinite,
+                            problem: format!("{n} samples NaN or infinite: drawn at the window's low end"),
+                        }),
+                        Err(e) => faults.push(Fault { chunk: key_name, kind: FaultKind::Unreadable, problem: e }),
                     }
                 }
             }
