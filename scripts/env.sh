@@ -6,8 +6,9 @@ export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/focal-target}"
 export CARGO_TERM_COLOR="${CARGO_TERM_COLOR:-never}"
 
 # Debian packages: software Vulkan (lavapipe) for GPU rendering where there is no GPU,
-# and a virtual X server for the app's window test.
-FOCAL_PACKAGES=(mesa-vulkan-drivers xvfb xauth)
+# a virtual X server for the app's window test, and OpenSSL's headers for the HTTP
+# store of OME-Zarr pyramids (reqwest's TLS).
+FOCAL_PACKAGES=(mesa-vulkan-drivers xvfb xauth libssl-dev pkg-config)
 
 ensure_packages() {
   local missing=()

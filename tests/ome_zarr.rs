@@ -1,14 +1,17 @@
 //! OME-Zarr against independent tools: pyramids written by zarr-python (Zarr v2 and v3,
 //! NGFF 0.4 and 0.5, gzip, blosc, zstd, sharding) open with the values their formulas
 //! give; pyramids `focal convert` writes are checked by zarr-python, nibabel and numpy
-//! (tests/oracle/); chunks that are corrupt, absent or truncated and metadata that is
-//! wrong give messages naming them and a picture of the rest.
+//! (tests/oracle/); chunks that are corrupt, absent or truncated, metadata that is wrong
+//! and HTTP faults (a loopback server: 404, 500, a dropped connection) give messages
+//! naming them and a picture of the rest.
 //!
 //! The oracle runs in `$FOCAL_ORACLE_PYTHON` (scripts/test.sh provides one with zarr,
 //! numpy and nibabel), else in a `python3` that has them; with neither the tests say so
 //! and pass only when `FOCAL_ORACLE_PYTHON` is unset.
 
 mod common;
+#[path = "ome_zarr/server.rs"]
+mod server;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -20,6 +23,7 @@ use focal::volume::readers::{ReadOptions, ome_zarr, read_volume};
 use focal::volume::source::level::read_level;
 use focal::volume::source::{FaultKind, VoxelSource};
 use glam::{UVec3, Vec3};
+use server::Fault;
 
 /// The oracle's interpreter, if there is one.
 fn python() -> Option<PathBuf> {
@@ -277,4 +281,59 @@ fn bad_chunks_and_metadata_are_named_and_the_rest_is_drawn() {
     std::fs::remove_dir_all(p.join("1")).expect("remove level");
     let err = ome_zarr::open(&p).map(|_| ()).expect_err("refused").to_string();
     assert!(err.contains("level 1"), "{err}");
+}
+
+#[test]
+fn pyramids_over_http_read_like_files_and_faults_are_named() {
+    let Some(dir) = fixtures() else { return };
+    let server = server::Server::start(dir.clone());
+    let start = std::time::Instant::now();
+    // Zarr v2 (gzip) and v3 (sharded, read by byte ranges) read over HTTP as from disk.
+    for name in ["v2_uint16.ome.zarr", "v3_float32_sharded.ome.zarr"] {
+        let url = format!("{}/{name}", server.url);
+        let remote = ome_zarr::open(Path::new(&url)).expect("opens over HTTP");
+        let local = ome_zarr::open(&dir.join(name)).expect("opens");
+        assert_eq!(remote.info().levels, local.info().levels);
+        for k in 0..local.info().levels.len() {
+            let (r, faults) = read_level(&remote, k, &|_| {}).expect("level");
+            let (l, _) = read_level(&local, k, &|_| {}).expect("level");
+            assert!(faults.iter().all(|f| f.kind == FaultKind::Absent), "{name} level {k}: {faults:?}");
+            assert_eq!(r.voxels, l.voxels, "{name} level {k}");
+        }
+    }
+    // The reader dispatch takes an address too.
+    let v = read_volume(Path::new(&format!("{}/v3_uint8.ome.zarr", server.url)), &ReadOptions::default()).expect("reads");
+    assert_eq!(v.dims(), UVec3::new(16, 14, 12));
+
+    // Faults: a 404 is an absent chunk; a 500 and a dropped connection are unreadable,
+    // named by their keys, and the rest of the box is drawn.
+    let url = format!("{}/v2_uint16.ome.zarr", server.url);
+    let s = ome_zarr::open(Path::new(&url)).expect("opens");
+    server.inject("v2_uint16.ome.zarr/0/0/0/0", Fault::Status(404));
+    server.inject("v2_uint16.ome.zarr/0/0/0/1", Fault::Status(500));
+    server.inject("v2_uint16.ome.zarr/0/0/1/0", Fault::Drop);
+    let b = s.read_box(0, UVec3::ZERO, UVec3::new(16, 16, 8)).expect("box");
+    let kind = |key: &str| b.faults.iter().find(|f| f.chunk == key).map(|f| (f.kind, f.problem.clone()));
+    assert_eq!(kind("0/0/0/0").map(|k| k.0), Some(FaultKind::Absent), "{:?}", b.faults);
+    let (k500, why) = kind("0/0/0/1").expect("the 500 is reported");
+    assert!(k500 == FaultKind::Unreadable && why.contains("500"), "{why}");
+    assert_eq!(kind("0/0/1/0").map(|k| k.0), Some(FaultKind::Unreadable), "{:?}", b.faults);
+    assert_eq!(b.faults.len(), 3, "{:?}", b.faults);
+    // Chunk (z 0, y 1, x 1) was served: its voxels are right.
+    let at = |x: u32, y: u32, z: u32| b.voxels.code(((z * 16 + y) * 16 + x) as usize) as u32;
+    // 7x + 13y at (9, 9, 0).
+    assert_eq!(at(9, 9, 0), 180);
+    assert_eq!(at(9, 1, 2), 0, "the 500 chunk (x 8..15, y 0..7) is drawn at the fill value");
+
+    // The metadata failing: the address and the status are named, nothing hangs.
+    server.inject("v2_int16_blosc.ome.zarr/.zgroup", Fault::Status(500));
+    let url = format!("{}/v2_int16_blosc.ome.zarr", server.url);
+    let err = ome_zarr::open(Path::new(&url)).map(|_| ()).expect_err("refused").to_string();
+    assert!(err.contains(&url) && err.contains("500"), "{err}");
+    server.inject("v3_uint8.ome.zarr/zarr.json", Fault::Drop);
+    let err = ome_zarr::open(Path::new(&format!("{}/v3_uint8.ome.zarr", server.url))).map(|_| ()).expect_err("refused").to_string();
+    assert!(err.contains("v3_uint8.ome.zarr"), "{err}");
+    let err = ome_zarr::open(Path::new(&format!("{}/nothing.ome.zarr", server.url))).map(|_| ()).expect_err("refused").to_string();
+    assert!(err.contains("nothing.ome.zarr"), "{err}");
+    assert!(start.elapsed() < std::time::Duration::from_secs(60), "HTTP faults took {:?}", start.elapsed());
 }

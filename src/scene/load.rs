@@ -48,7 +48,7 @@ impl LoadedDataset {
 
 /// A path of the scene file resolved against the scene's folder.
 pub fn resolve(base: &Path, p: &Path) -> PathBuf {
-    if p.is_absolute() { p.to_path_buf() } else { base.join(p) }
+    if p.is_absolute() || crate::volume::readers::ome_zarr::is_url(p) { p.to_path_buf() } else { base.join(p) }
 }
 
 /// Reads a scene file.

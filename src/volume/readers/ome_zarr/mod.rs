@@ -1,5 +1,5 @@
 //! OME-Zarr (OME-NGFF 0.4 on Zarr v2, 0.5 on Zarr v3): multiscale image pyramids, read
-//! through the `zarrs` crate.
+//! through the `zarrs` crate from a folder or over HTTP(S) (`zarrs_http`).
 //!
 //! [`open`] gives the whole pyramid as a [`ZarrSource`] (a [`VoxelSource`] read a box at
 //! a time); [`read`] gives one level as a [`Volume`], the finest whose codes fit in
@@ -15,6 +15,7 @@ use std::sync::Arc;
 use zarrs::filesystem::FilesystemStore;
 use zarrs::group::Group;
 use zarrs::storage::ReadableStorage;
+use zarrs_http::HTTPStore;
 
 pub use source::ZarrSource;
 
@@ -23,15 +24,29 @@ use crate::volume::Volume;
 use crate::volume::source::VoxelSource;
 use crate::volume::source::level::{WHOLE_LEVEL_BYTES, finest_within, load_finest_within};
 
-/// Whether `path` is a Zarr group (a folder with `zarr.json`, `.zgroup` or `.zattrs`).
+/// Whether `path` is a Zarr group: a folder with `zarr.json`, `.zgroup` or `.zattrs`, or
+/// an `http://` or `https://` address.
 pub fn is_zarr(path: &Path) -> bool {
-    path.is_dir() && ["zarr.json", ".zgroup", ".zattrs"].iter().any(|f| path.join(f).is_file())
+    is_url(path) || (path.is_dir() && ["zarr.json", ".zgroup", ".zattrs"].iter().any(|f| path.join(f).is_file()))
 }
 
-/// Opens the OME-Zarr image in the folder `path`.
+/// Whether `path` is an HTTP(S) address rather than a file.
+pub fn is_url(path: &Path) -> bool {
+    let s = path.to_string_lossy();
+    s.starts_with("http://") || s.starts_with("https://")
+}
+
+/// Opens the OME-Zarr image in the folder `path`, or at the address it names (read
+/// through `zarrs_http`: a 404 is an absent chunk, another status or a dropped
+/// connection an unreadable one).
 pub fn open(path: &Path) -> Result<ZarrSource, ReadError> {
     let fail = |p: Problem| ReadError::new(path, p);
-    let store: ReadableStorage = Arc::new(FilesystemStore::new(path).map_err(|e| fail(Problem::Io(std::io::Error::other(e.to_string()))))?);
+    let store: ReadableStorage = if is_url(path) {
+        let url = path.to_string_lossy();
+        Arc::new(HTTPStore::new(url.trim_end_matches('/')).map_err(|e| fail(Problem::Malformed(format!("not a usable address: {e}"))))?)
+    } else {
+        Arc::new(FilesystemStore::new(path).map_err(|e| fail(Problem::Io(std::io::Error::other(e.to_string()))))?)
+    };
     let group = Group::open(store.clone(), "/").map_err(|e| fail(Problem::Malformed(format!("not a readable Zarr group: {e}"))))?;
     let meta = metadata::parse(group.attributes()).map_err(|e| fail(Problem::Malformed(e)))?;
     ZarrSource::open(store, path, &meta).map_err(|e| fail(Problem::Malformed(e)))
