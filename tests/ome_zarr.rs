@@ -50,9 +50,14 @@ fn oracle(script: &str, args: &[&Path]) -> Option<String> {
 
 /// Pyramids written by zarr-python, once per test binary run.
 fn fixtures() -> Option<PathBuf> {
-    let dir = scratch("zarr-fixtures");
-    oracle("ome_zarr_make.py", &[&dir])?;
-    Some(dir)
+    // Made once: the tests run in parallel and must not rewrite each other's files.
+    static MADE: std::sync::OnceLock<Option<PathBuf>> = std::sync::OnceLock::new();
+    MADE.get_or_init(|| {
+        let dir = scratch("zarr-fixtures");
+        oracle("ome_zarr_make.py", &[&dir])?;
+        Some(dir)
+    })
+    .clone()
 }
 
 /// Every voxel of every level of `source`, against `expected(level, x, y, z)`.

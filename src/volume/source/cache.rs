@@ -174,7 +174,12 @@ impl BrickCache {
             let (source, layout, state, budget) = (self.source.clone(), self.layout, self.state.clone(), self.budget);
             let pinned = info.levels.len() - 1;
             (self.spawner)(Box::new(move || {
-                let result = layout.read(source.as_ref(), k.level as usize, k.coords());
+                // A panicking read must neither abort the pool nor leave the key pending.
+                let read =
+                    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| layout.read(source.as_ref(), k.level as usize, k.coords())));
+                let result = read.unwrap_or_else(|_| {
+                    Err(SourceError::new(&source.info().name, format!("reading brick {:?} of level {} panicked", k.brick, k.level)))
+                });
                 let mut s = lock(&state);
                 s.pending.remove(&k);
                 match result {

@@ -111,6 +111,11 @@ pub fn parse(attributes: &Map<String, Value>) -> Result<Multiscale, String> {
         }
     };
     let global = ms.get("coordinateTransformations").map(|t| transforms_of(t, axes.len())).transpose()?;
+    if let Some((gs, _)) = &global
+        && gs.len() != axes.len()
+    {
+        return Err(format!("the multiscale's scale has {} values for {} axes", gs.len(), axes.len()));
+    }
     let mut datasets = Vec::new();
     for d in datasets_json {
         let path = d.get("path").and_then(Value::as_str).ok_or("a dataset has no \"path\"")?.to_owned();
@@ -303,6 +308,9 @@ mod tests {
         let short = json!({"multiscales": [{"axes": ["z", "y", "x"], "datasets": [
             {"path": "0", "coordinateTransformations": [{"type": "scale", "scale": [1.0, 1.0]}]}]}]});
         assert!(err(short).contains("2 scale values for 3 axes"));
+        let short_global = json!({"multiscales": [{"axes": ["z", "y", "x"], "coordinateTransformations": [{"type": "scale", "scale": [1.0, 2.0]}],
+            "datasets": [{"path": "0", "coordinateTransformations": [{"type": "scale", "scale": [1.0, 1.0, 1.0]}]}]}]});
+        assert!(err(short_global).contains("2 values for 3 axes"));
         let by_file = json!({"multiscales": [{"axes": ["z", "y", "x"], "datasets": [
             {"path": "0", "coordinateTransformations": [{"type": "scale", "path": "scale.bin"}]}]}]});
         assert!(err(by_file).contains("not supported"));
