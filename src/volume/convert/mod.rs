@@ -94,16 +94,12 @@ impl SampleKind {
     }
 }
 
-/// Number of levels for a volume of `dims` in chunks of `chunk`: until a level fits one.
-pub fn level_count(dims: UVec3, chunk: u32) -> usize {
-    super::source::level_count(dims, chunk)
-}
-
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
 
     use super::*;
+    use crate::volume::source::level_count;
     use crate::volume::{Grid, Source, ValueMap};
 
     #[test]

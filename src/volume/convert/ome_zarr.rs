@@ -24,7 +24,9 @@ use zarrs::group::{Group, GroupMetadata, GroupMetadataV3};
 use zarrs::metadata::v2::GroupMetadataV2;
 use zarrs::storage::ReadableWritableListableStorage;
 
-use super::{Downsample, SampleKind, level_count, next_level};
+use super::{Downsample, SampleKind, next_level};
+use crate::volume::readers::ome_zarr::is_zarr;
+use crate::volume::source::level_count;
 use crate::volume::{ValueMap, Volume, Voxels, grid::fmt_dims};
 
 /// Zarr format and NGFF version written.
@@ -114,7 +116,7 @@ fn prepare_folder(out: &Path, overwrite: bool) -> Result<(), String> {
     if out.exists() {
         let empty = out.read_dir().map(|mut d| d.next().is_none()).unwrap_or(false);
         if !empty {
-            let is_zarr = ["zarr.json", ".zgroup", ".zattrs"].iter().any(|f| out.join(f).is_file());
+            let is_zarr = is_zarr(out);
             if !overwrite || !is_zarr {
                 return Err(format!(
                     "{} exists{}",
