@@ -43,6 +43,9 @@
 #ifdef HAS_TWO_LEVEL
 #import focal::two_level::{NO_PART, Open, fresh, close_segment, end_segment, two_level_sample, open_part}
 #endif
+#ifdef HAS_BRICKED
+#import focal::footprint::{prepare_ray_footprint, bricked_step_at}
+#endif
 
 @fragment
 fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
@@ -56,6 +59,9 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #endif
 #else
     let ray = pixel_ray(in.uv);
+#endif
+#ifdef HAS_BRICKED
+    prepare_ray_footprint(in.uv, ray);
 #endif
     if (settings.flags & VIEW_DEBUG_RAYS) != 0u {
         return vec4(ray.dir * 0.5 + 0.5, 1.0);
@@ -117,7 +123,13 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                 t_end = max(t_end, iv.y);
 #endif
                 if n > first {
-                    let ws = world_step(regions[i], ray.dir);
+                    var ws = world_step(regions[i], ray.dir);
+#ifdef HAS_BRICKED
+                    // A bricked region steps at the level its footprint asks for.
+                    if regions[i].bricked.x != 0u {
+                        ws *= bricked_step_at(regions[i], ray.dir, t0);
+                    }
+#endif
                     step = min(step, ws);
                     let factor = regions[i].native_step / (ws * regions[i].reference_length);
                     let mode = regions[i].mode;

@@ -20,6 +20,7 @@ pub mod reference;
 pub mod region;
 pub mod render;
 pub mod scene;
+pub mod streaming;
 pub mod transfer;
 pub mod twolevel;
 pub mod ui;
@@ -39,6 +40,7 @@ impl PluginGroup for FocalCorePlugins {
             .add(lens::LensPlugin)
             .add(windows::VolumeWindowPlugin)
             .add(explode::ExplodePlugin)
+            .add(streaming::StreamingPlugin)
     }
 }
 

@@ -9,6 +9,8 @@
 //! 8-bit sRGB: the mean absolute difference must stay below 1 level and 99 % of the
 //! pixels within 6 levels; a few pixels where a ray grazes a steep edge may differ more.
 
+#[path = "gpu/bricked.rs"]
+mod bricked;
 #[path = "gpu/clip.rs"]
 mod clip;
 mod common;
@@ -342,7 +344,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 24] = [
+    let tests: [GpuTest; 25] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -367,6 +369,7 @@ fn main() {
         ("an_exploded_head_matches_the_reference", explode::an_exploded_head_matches_the_reference),
         ("eighteen_exploded_parts_match_the_reference", explode::eighteen_exploded_parts_match_the_reference),
         ("a_selection_on_its_own_grid_matches_the_reference", explode::a_selection_on_its_own_grid_matches_the_reference),
+        ("bricked_ch2_converges_to_the_chosen_level_in_memory", bricked::bricked_ch2_converges_to_the_chosen_level_in_memory),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

@@ -34,6 +34,8 @@ const LAYERS: &[&str] = &[
     "reference",
     "windows",
     "explode",
+    // Streaming bricked datasets: the bricks every view (lenses, windows, parts) wants.
+    "streaming",
     // The GPU ray caster: packs what the techniques produce.
     "render",
     "lib.rs",

@@ -15,3 +15,6 @@
 @group(0) @binding(9) var volume_sampler: sampler;
 @group(0) @binding(10) var depth_texture: texture_depth_2d;
 @group(0) @binding(11) var<storage, read> feature_fields: array<f32>;
+// The brick atlas of bricked volumes and their page tables (render::bricked::atlas).
+@group(0) @binding(12) var brick_cache: texture_3d<f32>;
+@group(0) @binding(13) var<storage, read> pages: array<u32>;

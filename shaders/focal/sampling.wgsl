@@ -6,7 +6,8 @@
 // and min-max (reference: volume::sample, volume::bricks).
 
 #import focal::types::{Region, REGION_LABELS}
-#import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy, lut_atlas}
+#import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy, lut_atlas, brick_cache, pages}
+#import focal::bricked::{is_bricked, level_zero, bricked_locate, bricked_texel, bricked_box_exit, bricked_step_factor, bc_kind, bc_code, BRICKED_TEXEL, BRICKED_EMPTY}
 
 // Mip level the samples come from: set per sample under lenses with anti-aliasing
 // (focal::lens::update_lod), 0 otherwise (reference: PreparedRegion::sample).
@@ -51,7 +52,7 @@ fn level_sample(r: Region, q: vec3<f32>, k: u32) -> f32 {
 
 // Trilinear sample (normalised) at continuous voxel index q, clamped to the edge voxels;
 // under lenses from the current mip level (two levels blended).
-fn trilinear(r: Region, q: vec3<f32>) -> f32 {
+fn trilinear_memory(r: Region, q: vec3<f32>) -> f32 {
 #ifdef LENS_ANTIALIAS
     // (A shader def, not the view's flag: llvmpipe runs an `if` in every lane whatever
     // the condition, and this code made every sample under a lens three times as
@@ -67,11 +68,46 @@ fn trilinear(r: Region, q: vec3<f32>) -> f32 {
 #endif
 }
 
+// 1 / the brick atlas's size, from the page buffer's header.
+fn cache_inv_size() -> vec3<f32> {
+    return vec3(bitcast<f32>(pages[4]), bitcast<f32>(pages[5]), bitcast<f32>(pages[6]));
+}
+
+// Sample of a bricked region: the finest drawn brick holding q, an empty brick's lowest
+// code (invisible under every look of the volume), else the coarse volume.
+fn bricked_sample(r: Region, q: vec3<f32>) -> f32 {
+    let q0 = level_zero(r, q);
+    bricked_locate(r, q0);
+    if bc_kind == BRICKED_TEXEL {
+        return textureSampleLevel(brick_cache, volume_sampler, bricked_texel(q0) * cache_inv_size(), 0.0).r;
+    }
+    if bc_kind == BRICKED_EMPTY {
+        return bc_code / r.dims.w;
+    }
+    return trilinear_box(r.atlas_offset.xyz, r.dims.xyz, q);
+}
+
+// Trilinear sample (normalised) at continuous voxel index q of the region's volume
+// (bricked volumes through their page table).
+fn trilinear(r: Region, q: vec3<f32>) -> f32 {
+#ifdef HAS_BRICKED
+    if is_bricked(r) {
+        return bricked_sample(r, q);
+    }
+#endif
+    return trilinear_memory(r, q);
+}
+
 // The sample at q (x, as trilinear) and the degree of interest its volume carries in
 // the second channel (y, the selection's normalised sample): one fetch; under lenses
 // with anti-aliasing the value may come from the mip levels, and the degree of
 // interest, which only the volume itself carries, from a fetch of its own.
 fn trilinear_with_doi(r: Region, q: vec3<f32>) -> vec2<f32> {
+#ifdef HAS_BRICKED
+    if is_bricked(r) {
+        return vec2(bricked_sample(r, q), atlas_texel(r.atlas_offset.xyz, r.dims.xyz, q).g);
+    }
+#endif
 #ifdef LENS_ANTIALIAS
     return vec2(trilinear(r, q), atlas_texel(r.atlas_offset.xyz, r.dims.xyz, q).g);
 #else
@@ -81,6 +117,18 @@ fn trilinear_with_doi(r: Region, q: vec3<f32>) -> vec2<f32> {
 
 // Code of the voxel nearest to q (label volumes).
 fn nearest_code(r: Region, q: vec3<f32>) -> u32 {
+#ifdef HAS_BRICKED
+    if is_bricked(r) {
+        let q0 = level_zero(r, q);
+        bricked_locate(r, q0);
+        if bc_kind == BRICKED_TEXEL {
+            return u32(round(textureLoad(brick_cache, vec3<i32>(floor(bricked_texel(q0))), 0).r * r.dims.w));
+        }
+        if bc_kind == BRICKED_EMPTY {
+            return u32(bc_code);
+        }
+    }
+#endif
     let c = clamp(floor(q + 0.5), vec3(0.0), r.dims.xyz - 1.0);
     return u32(round(textureLoad(volume_atlas, vec3<i32>(r.atlas_offset.xyz + c), 0).r * r.dims.w));
 }
@@ -111,9 +159,16 @@ fn index_gradient(r: Region, q: vec3<f32>, atlas_width: u32) -> vec3<f32> {
         return 0.5 * g;
     }
 #endif
+    // (A bricked region's differences span one voxel of the level its ray steps at.)
+    var h = 1.0;
+#ifdef HAS_BRICKED
+    if is_bricked(r) {
+        h = bricked_step_factor();
+    }
+#endif
     for (var a = 0; a < 3; a++) {
         var e = vec3(0.0);
-        e[a] = 1.0;
+        e[a] = h;
         g[a] = trilinear(r, q + e) - trilinear(r, q - e);
     }
     return 0.5 * g;
@@ -127,6 +182,17 @@ fn brick_of(r: Region, q: vec3<f32>) -> vec3<u32> {
 }
 
 fn brick_occupied(r: Region, q: vec3<f32>) -> bool {
+#ifdef HAS_BRICKED
+    if is_bricked(r) {
+        bricked_locate(r, level_zero(r, q));
+        if bc_kind == BRICKED_EMPTY {
+            return false;
+        }
+        if bc_kind == BRICKED_TEXEL {
+            return true;
+        }
+    }
+#endif
     let b = brick_of(r, q);
     let i = (b.z * r.bricks.y + b.y) * r.bricks.x + b.x;
     let word = occupancy[r.occupancy_offset + i / 32u];
@@ -147,11 +213,23 @@ fn brick_exit(r: Region, q: vec3<f32>, qd: vec3<f32>, t: f32) -> f32 {
             exit = min(exit, (lo[a] - q[a]) / qd[a]);
         }
     }
+#ifdef HAS_BRICKED
+    if is_bricked(r) {
+        bricked_locate(r, level_zero(r, q));
+        return bricked_box_exit(r, q, qd, t, t + max(exit, 0.0));
+    }
+#endif
     return t + max(exit, 0.0);
 }
 
 // Code range of q's brick, normalised.
 fn brick_range(r: Region, q: vec3<f32>) -> vec2<f32> {
+#ifdef HAS_BRICKED
+    // (The coarse level's ranges do not bound its finer levels.)
+    if is_bricked(r) {
+        return vec2(0.0, 1.0);
+    }
+#endif
     let b = brick_of(r, q) + r.brick_offset.xyz;
     return vec2<f32>(textureLoad(brick_atlas, vec3<i32>(b), 0).rg) / r.dims.w;
 }

@@ -43,6 +43,11 @@ struct Region {
     cluster: vec4<f32>,
     // Segmented regions: first part record, part count, label record.
     objects: vec4<u32>,
+    // A bricked volume: page directory index + 1 (0: in memory), brick size, apron,
+    // coarse level C (render::bricked).
+    bricked: vec4<u32>,
+    // 2^C, the level-0 voxel size in the volume's own millimetres.
+    bricked_scale: vec4<f32>,
 }
 
 struct Lens {

@@ -176,6 +176,9 @@ impl SelectionWeight {
     }
 }
 
+/// Whether codes `lo ..= hi` can show anything ([`Appearance::code_visibility`]).
+pub type CodeVisibility = Box<dyn Fn(u16, u16) -> bool + Send + Sync>;
+
 /// The appearance of a region.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Appearance {
@@ -245,19 +248,36 @@ impl Appearance {
     /// [`Self::brick_occupancy`] of this appearance's own mode and lookup (for a
     /// segmented volume: of the rest).
     fn own_brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {
-        let bricks = volume.bricks();
+        let visible = self.own_code_visibility(volume)?;
+        Some(volume.bricks().occupancy(visible))
+    }
+
+    /// Whether codes between `lo` and `hi` (inclusive) can show anything under this
+    /// appearance's own mode and lookup, for `volume`'s codes; `None` where every code
+    /// may (projections, iso-surfaces).
+    fn own_code_visibility(&self, volume: &Volume) -> Option<CodeVisibility> {
         match &self.lookup {
             Lookup::Transfer(tf) if matches!(self.mode, Mode::Dvr | Mode::GradientDvr | Mode::Context) => {
                 let lut = Lut::for_volume(tf, volume);
-                let map = &volume.values;
-                Some(bricks.occupancy(|lo, hi| lut.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0))
+                let map = volume.values.clone();
+                Some(Box::new(move |lo, hi| lut.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0))
             }
             Lookup::Transfer(_) => None,
             Lookup::Labels(styles) => {
                 let table = styles.bake(volume.stats.code_max as usize + 1);
-                Some(bricks.occupancy(|lo, hi| table.get(lo as usize..=hi as usize).is_some_and(|t| t.iter().any(|c| c[3] > 0.0))))
+                Some(Box::new(move |lo, hi| table.get(lo as usize..=hi as usize).is_some_and(|t| t.iter().any(|c| c[3] > 0.0))))
             }
         }
+    }
+
+    /// [`Self::own_code_visibility`] for a whole appearance: `None` also where a
+    /// segmentation or selection decides (bricks streamed with such a look are never
+    /// skipped as empty). `volume` gives the codes' meaning (any level of a pyramid).
+    pub fn code_visibility(&self, volume: &Volume) -> Option<CodeVisibility> {
+        if self.segmentation.is_some() || self.selection.is_some() {
+            return None;
+        }
+        self.own_code_visibility(volume)
     }
 
     /// World-space bounds of what this appearance shows of `volume` (the bricks with any

@@ -9,6 +9,7 @@ use bevy::render::sync_component::SyncComponent;
 use super::gpu_types::{GpuSettings, view_flags};
 use crate::dataset::{SceneRegions, VolumeView};
 use crate::region::{Light, RenderScene};
+use crate::streaming::bricked::{BrickFrame, BrickedScene, StreamBudget};
 
 impl SyncComponent for VolumeView {
     type Target = GpuSettings;
@@ -65,9 +66,22 @@ pub fn request_depth_binding(mut cams: Query<(&mut Camera3d, &mut VolumeView)>, 
 #[derive(Resource, Clone, Default)]
 pub struct ExtractedScene {
     pub scene: RenderScene,
+    /// The bricked frame of each of the scene's volumes (`None`: in memory).
+    pub bricked: Vec<Option<BrickFrame>>,
+    pub budget: StreamBudget,
 }
 
-/// Copies the scene regions into the render world (shared volumes, small vectors).
-pub fn extract_scene(mut commands: Commands, scene: Extract<Res<SceneRegions>>) {
-    commands.insert_resource(ExtractedScene { scene: scene.scene.clone() });
+/// Copies the scene regions into the render world (shared volumes, small vectors), and
+/// what streaming drew.
+pub fn extract_scene(
+    mut commands: Commands,
+    scene: Extract<Res<SceneRegions>>,
+    bricked: Extract<Option<Res<BrickedScene>>>,
+    budget: Extract<Option<Res<StreamBudget>>>,
+) {
+    commands.insert_resource(ExtractedScene {
+        scene: scene.scene.clone(),
+        bricked: bricked.as_ref().map(|b| b.volumes.clone()).unwrap_or_default(),
+        budget: budget.as_deref().copied().unwrap_or_default(),
+    });
 }

@@ -76,9 +76,12 @@ pub mod features {
     pub const DOI_CHANNEL: u32 = 16384;
     /// Some region draws another in its samples (`render::pack::companions`).
     pub const COMPANION: u32 = 32768;
+    /// Some region samples a bricked volume through its page table
+    /// (`render::bricked`).
+    pub const BRICKED: u32 = 65536;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 16] = [
+    pub const NAMES: [(u32, &str); 17] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -95,6 +98,7 @@ pub mod features {
         (HOLES, "HAS_HOLES"),
         (DOI_CHANNEL, "DOI_CHANNEL"),
         (COMPANION, "COMPANION"),
+        (BRICKED, "HAS_BRICKED"),
     ];
 }
 
@@ -168,6 +172,12 @@ pub struct GpuRegion {
     /// selection volume, its map from the data's voxel index, `lut_a·t + lut_b` the
     /// degree of interest of a normalised sample `t`).
     pub objects: UVec4,
+    /// A bricked volume (`render::bricked`): its place in the page directory + 1 (`0`:
+    /// in memory), brick size, apron, coarse level `C`.
+    pub bricked: UVec4,
+    /// `2^C` (coarse voxel index → level-0 index), the level-0 voxel size in the volume's
+    /// own millimetres (the footprint's unit for a ray's level).
+    pub bricked_scale: Vec4,
 }
 
 /// Regions the interval loop tests together (`REGION_CLUSTER` in

@@ -24,6 +24,10 @@ use bevy::winit::WinitPlugin;
 use super::VolumeView;
 use super::pipeline::RaycastPipelineId;
 use super::upload::GpuScene;
+use crate::streaming::bricked::StreamStatus;
+
+/// Longest wait of a headless render for streaming to converge.
+pub const STREAM_WAIT: Duration = Duration::from_secs(300);
 use crate::region::{Camera as FocalCamera, Projection as FocalProjection};
 use bevy::render::RenderApp;
 use bevy::render::render_resource::{CachedPipelineState, PipelineCache};
@@ -183,6 +187,7 @@ impl Offscreen {
                 return Err("the ray caster did not get ready (no volume uploaded or no pipeline)".into());
             }
         }
+        self.wait_for_streaming();
         let captured: Arc<Mutex<Option<Image>>> = default();
         let sink = captured.clone();
         self.app.world_mut().spawn(Screenshot::image(self.target.clone())).observe(move |ev: On<ScreenshotCaptured>| {
@@ -199,6 +204,35 @@ impl Offscreen {
             }
         }
         Err("the GPU produced no image".into())
+    }
+
+    /// Runs frames until every brick the view wants is drawn (bricked datasets), at most
+    /// [`STREAM_WAIT`]; a picture that did not converge is logged.
+    pub fn wait_for_streaming(&mut self) -> bool {
+        let Some(status) = self.app.world().get_resource::<StreamStatus>().cloned() else { return true };
+        let start = Instant::now();
+        loop {
+            if status.converged() {
+                return true;
+            }
+            if start.elapsed() > STREAM_WAIT {
+                let c = status.counts();
+                warn!(
+                    "streaming did not converge within {} s: {} of {} wanted bricks in memory, {} loading, {} not yet on the GPU",
+                    STREAM_WAIT.as_secs(),
+                    c.resident,
+                    c.wanted,
+                    c.pending,
+                    c.not_uploaded
+                );
+                return false;
+            }
+            if status.counts().pending > 0 {
+                // (The loads run on other threads: a frame less for them to wait on.)
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            self.update();
+        }
     }
 
     /// Average wall-clock time of `frames` frames (after the scene settled).

@@ -59,12 +59,15 @@ impl Plugin for VolumeRenderPlugin {
             ))
             .add_systems(PostUpdate, (extract::request_depth_binding, fit_datasets.before(crate::dataset::RegionSystems::Collect)));
 
+        let status = app.world().get_resource::<crate::streaming::bricked::StreamStatus>().cloned().unwrap_or_default();
         let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
             return;
         };
         render_app
             .insert_resource(progress)
+            .insert_resource(status)
             .init_resource::<upload::GpuScene>()
+            .init_resource::<bricked::atlas::BrickAtlas>()
             .init_resource::<bevy::render::render_resource::SpecializedRenderPipelines<pipeline::RaycastPipeline>>()
             .add_systems(bevy::render::ExtractSchedule, extract::extract_scene)
             .add_systems(RenderStartup, (pipeline::init_pipeline, feature_pass::init_feature_pipelines))
@@ -72,6 +75,7 @@ impl Plugin for VolumeRenderPlugin {
                 Render,
                 (
                     upload::upload_scene.in_set(RenderSystems::PrepareResources),
+                    bricked::atlas::upload_bricks.in_set(RenderSystems::PrepareResources).after(upload::upload_scene),
                     feature_pass::prepare_feature_buffers.in_set(RenderSystems::PrepareResources).after(upload::upload_scene),
                     pipeline::prepare_pipelines.in_set(RenderSystems::Prepare),
                     record_pipeline_state.in_set(RenderSystems::Cleanup),

@@ -442,6 +442,8 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
         bounds: polyhedron_sphere(&p.region.planes),
         cluster: Vec4::ZERO,
         objects: UVec4::ZERO,
+        bricked: UVec4::ZERO,
+        bricked_scale: Vec4::ZERO,
     }
 }
 

@@ -32,6 +32,7 @@ pub fn raycast_pass(
     view_uniforms: Res<ViewUniforms>,
     settings: Res<ComponentUniforms<GpuSettings>>,
     scene: Res<GpuScene>,
+    bricks: Res<super::bricked::atlas::BrickAtlas>,
     progress: Res<super::progress::RenderProgress>,
     mut ctx: RenderContext,
 ) {
@@ -49,6 +50,7 @@ pub fn raycast_pass(
     else {
         return;
     };
+    let (Some(brick_view), Some(pages)) = (&bricks.view, &bricks.pages) else { return };
     // The feature lenses' silhouettes, found first where the GPU finds them.
     let Some(fields) = fields else { return };
     if !encode_feature_passes(&mut ctx, fields, &feature_pipelines, &cache, &scene, (view_binding.clone(), view_offset.offset)) {
@@ -70,6 +72,8 @@ pub fn raycast_pass(
             &pipeline.sampler,
             depth.view(),
             fields.fields.as_entire_binding(),
+            brick_view,
+            pages.as_entire_binding(),
         )),
     );
     let diagnostics = ctx.diagnostic_recorder();

@@ -40,6 +40,8 @@ pub fn init_pipeline(mut commands: Commands, device: Res<RenderDevice>, fullscre
                 sampler(SamplerBindingType::Filtering),
                 texture_depth_2d(),
                 storage_buffer_read_only_sized(false, None),
+                texture_3d(float(true)),
+                storage_buffer_read_only_sized(false, None),
             ),
         ),
     );

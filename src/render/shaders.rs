@@ -13,7 +13,7 @@ pub const RAYCAST: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b
 pub const FEATURE: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a12");
 
 /// (fixed handle, file name, source) of every shader.
-const SHADERS: [(Handle<Shader>, &str, &str); 16] = [
+const SHADERS: [(Handle<Shader>, &str, &str); 18] = [
     (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a01"), "shaders/focal/types.wgsl", include_str!("../../shaders/focal/types.wgsl")),
     (
         uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a02"),
@@ -55,6 +55,12 @@ const SHADERS: [(Handle<Shader>, &str, &str); 16] = [
         uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a0e"),
         "shaders/focal/two_level.wgsl",
         include_str!("../../shaders/focal/two_level.wgsl"),
+    ),
+    (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a0f"), "shaders/focal/bricked.wgsl", include_str!("../../shaders/focal/bricked.wgsl")),
+    (
+        uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a10"),
+        "shaders/focal/footprint.wgsl",
+        include_str!("../../shaders/focal/footprint.wgsl"),
     ),
     (RAYCAST, "shaders/raycast.wgsl", include_str!("../../shaders/raycast.wgsl")),
     (FEATURE, "shaders/feature.wgsl", include_str!("../../shaders/feature.wgsl")),

@@ -46,6 +46,10 @@ pub struct GpuScene {
     pub features: u32,
     /// Messages about regions that could not be drawn.
     pub dropped: Vec<String>,
+    /// The scene volume of each page directory entry (`render::bricked::mark`).
+    pub bricked_directory: Vec<usize>,
+    /// The coarse level of each bricked scene volume the packing saw.
+    bricked_key: Vec<Option<usize>>,
 }
 
 impl GpuScene {
@@ -73,10 +77,11 @@ pub fn upload_scene(
 ) {
     let Some(extracted) = extracted else { return };
     let scene = &extracted.scene;
-    if gpu.last.as_ref().is_some_and(|last| same_scene(last, scene)) && gpu.ready() {
+    let bricked_key: Vec<Option<usize>> = extracted.bricked.iter().map(|f| f.as_ref().map(|f| f.coarse)).collect();
+    if gpu.last.as_ref().is_some_and(|last| same_scene(last, scene)) && gpu.ready() && gpu.bricked_key == bricked_key {
         return;
     }
-    let packed = match pack(scene, device.limits().max_texture_dimension_3d) {
+    let mut packed = match pack(scene, device.limits().max_texture_dimension_3d) {
         Ok(p) => p,
         Err(e) => {
             error!("cannot draw the scene: {e}");
@@ -86,6 +91,8 @@ pub fn upload_scene(
     for d in &packed.dropped {
         warn!("{d}");
     }
+    gpu.bricked_directory = super::bricked::mark::mark_bricked(&mut packed, scene, &extracted.bricked);
+    gpu.bricked_key = bricked_key;
     if !packed.mips && !packed.volumes.is_empty() {
         warn!(
             "no room for the volumes' mip chains in one texture atlas: lenses sample full resolution where they compress (the CPU reference does not)"
@@ -114,7 +121,7 @@ pub fn upload_scene(
 
 /// The 16-bit formats of one and two channels: normalised where the device filters
 /// them, else half floats.
-fn sixteen_bit_formats(adapter: &RenderAdapter) -> [TextureFormat; 2] {
+pub fn sixteen_bit_formats(adapter: &RenderAdapter) -> [TextureFormat; 2] {
     let filterable = |format: TextureFormat| {
         let f = adapter.get_texture_format_features(format);
         f.allowed_usages.contains(TextureUsages::TEXTURE_BINDING) && f.flags.contains(TextureFormatFeatureFlags::FILTERABLE)
@@ -216,11 +223,7 @@ fn volume_texels(volumes: &[(&Volume, Option<&Volume>)], packed: &PackedScene, f
             out[0] = c as u8;
             return;
         }
-        let c = c as u32 * if bits == 8 { 257 } else { 1 };
-        out.copy_from_slice(&match format {
-            TextureFormat::R16Unorm | TextureFormat::Rg16Unorm => (c as u16).to_le_bytes(),
-            _ => half::f16::from_f32(c as f32 / 65535.0).to_le_bytes(),
-        });
+        out.copy_from_slice(&texel16(c, bits, format));
     };
     let mut data = vec![0u8; texels * bytes];
     for (slot, (v, second)) in volumes.iter().enumerate() {
@@ -253,6 +256,16 @@ fn volume_texels(volumes: &[(&Volume, Option<&Volume>)], packed: &PackedScene, f
         }
     }
     (format, data)
+}
+
+/// One 16-bit channel of code `c` (of `bits`-bit codes: 8-bit codes become `257·c`, the
+/// same normalised value) in `format`: normalised, or a half float of `c / 65535`.
+pub fn texel16(c: u16, bits: u32, format: TextureFormat) -> [u8; 2] {
+    let c = c as u32 * if bits == 8 { 257 } else { 1 };
+    match format {
+        TextureFormat::R16Unorm | TextureFormat::Rg16Unorm => (c as u16).to_le_bytes(),
+        _ => half::f16::from_f32(c as f32 / 65535.0).to_le_bytes(),
+    }
 }
 
 fn storage<T: bevy::render::render_resource::ShaderType + bevy::render::render_resource::encase::internal::WriteInto>(

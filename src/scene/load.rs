@@ -9,10 +9,12 @@ use super::file::{CameraSpec, Change, DatasetSpec, SceneFile, SourceSpec, vec3};
 use crate::clip::Clipping;
 use crate::dataset::Dataset;
 use crate::region::{Appearance, Camera, Lookup, Orbit, Projection, RenderScene, Segmentation, SegmentationSpec, View};
+use crate::streaming::bricked::{BrickedDataset, StreamBudget};
 use crate::transfer::presets;
 use crate::twolevel::spec::LabelSource;
 use crate::volume::phantom::head;
 use crate::volume::readers::{Progress, RawSpec, ReadOptions, label_table, read_volume};
+use crate::volume::source::VoxelSource;
 use crate::volume::source::level::{WHOLE_LEVEL_BYTES, load_finest_within};
 use crate::volume::source::procedural::ProceduralSource;
 use crate::volume::{LabelTable, LabelVolume, Volume};
@@ -31,6 +33,8 @@ pub struct LoadedDataset {
     pub spec: DatasetSpec,
     /// Its exploded view, loaded.
     pub explode: Option<crate::explode::spec::LoadedExplode>,
+    /// Streamed brick by brick from a pyramid (its `volume` is the coarse level).
+    pub bricked: Option<BrickedDataset>,
 }
 
 impl LoadedDataset {
@@ -114,29 +118,70 @@ pub fn segmentation(spec: &SegmentationSpec, datasets: &[LoadedDataset], data: &
     crate::twolevel::spec::segmentation(spec, labels, data, base)
 }
 
+/// A pyramid opened for streaming (its coarse level read), or `None` where one whole
+/// level serves (the reason is logged).
+fn open_bricked(source: Arc<dyn VoxelSource>) -> Result<Option<(BrickedDataset, Volume)>, String> {
+    match BrickedDataset::open(source, StreamBudget::default().cpu_bytes)? {
+        Ok(opened) => Ok(Some(opened)),
+        Err(why) => {
+            bevy::log::warn!("{why}");
+            Ok(None)
+        }
+    }
+}
+
 fn load_dataset(spec: &DatasetSpec, base: &Path, options: &ReadOptions) -> Result<LoadedDataset, String> {
-    let (volume, sidecar_from) = match &spec.source {
-        SourceSpec::Phantom { kind, resolution } => (kind.generate(*resolution)?, None),
+    let (volume, sidecar_from, bricked) = match &spec.source {
+        SourceSpec::Phantom { kind, resolution } => (kind.generate(*resolution)?, None, None),
         SourceSpec::PhantomLabels { resolution } => {
             let h = head::generate(*resolution)?;
             let table = h.labels.table.clone();
             let app = spec.appearance.appearance(&h.labels.volume, Some(&table), base)?;
             return dataset(spec, h.labels.volume, app, Some(table));
         }
+        SourceSpec::File(p) if crate::volume::readers::ome_zarr::is_zarr(&resolve(base, p)) => {
+            let p = resolve(base, p);
+            let source = crate::volume::readers::ome_zarr::open(&p).map_err(|e| e.to_string())?;
+            for w in &source.info().warnings {
+                bevy::log::warn!("{}: {w}", p.display());
+            }
+            let source: Arc<dyn VoxelSource> = Arc::new(source);
+            match open_bricked(source.clone())? {
+                Some((b, coarse)) => (coarse, Some(p), Some(b)),
+                None => {
+                    (crate::volume::readers::ome_zarr::read_source(source.as_ref(), &p, options).map_err(|e| e.to_string())?, Some(p), None)
+                }
+            }
+        }
         SourceSpec::File(p) => {
             let p = resolve(base, p);
-            (read_volume(&p, options).map_err(|e| e.to_string())?, Some(p))
+            (read_volume(&p, options).map_err(|e| e.to_string())?, Some(p), None)
         }
         SourceSpec::Raw { path, layout } => {
             let raw: RawSpec = layout.parse()?;
             let p = resolve(base, path);
-            (read_volume(&p, &ReadOptions { raw: Some(raw), ..options.clone() }).map_err(|e| e.to_string())?, Some(p))
+            (read_volume(&p, &ReadOptions { raw: Some(raw), ..options.clone() }).map_err(|e| e.to_string())?, Some(p), None)
         }
         SourceSpec::Procedural { dims, spacing_mm } => {
-            let source = ProceduralSource::new(UVec3::new(dims.0, dims.1, dims.2), Vec3::splat(*spacing_mm))?;
-            (load_finest_within(&source, WHOLE_LEVEL_BYTES.min(options.max_bytes), &|_| {}).map_err(|e| e.to_string())?, None)
+            let source: Arc<dyn VoxelSource> =
+                Arc::new(ProceduralSource::new(UVec3::new(dims.0, dims.1, dims.2), Vec3::splat(*spacing_mm))?);
+            match open_bricked(source.clone())? {
+                Some((b, coarse)) => (coarse, None, Some(b)),
+                None => (
+                    load_finest_within(source.as_ref(), WHOLE_LEVEL_BYTES.min(options.max_bytes), &|_| {}).map_err(|e| e.to_string())?,
+                    None,
+                    None,
+                ),
+            }
         }
     };
+    let mut d = labelled(spec, base, volume, sidecar_from)?;
+    d.bricked = bricked;
+    Ok(d)
+}
+
+/// The dataset of a spec's volume: as labels where the spec says so.
+fn labelled(spec: &DatasetSpec, base: &Path, volume: Volume, sidecar_from: Option<PathBuf>) -> Result<LoadedDataset, String> {
     match &spec.appearance.labels {
         Some(labels) => {
             let table = match (&labels.table, &sidecar_from) {
@@ -168,6 +213,7 @@ fn dataset(spec: &DatasetSpec, volume: Volume, appearance: Appearance, table: Op
         clip: spec.clip.clone().validated()?,
         spec: spec.clone(),
         explode: None,
+        bricked: None,
     })
 }
 

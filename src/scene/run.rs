@@ -98,7 +98,16 @@ impl GpuRun {
         let mut off = Offscreen::new(w, h, |app| {
             app.add_plugins((FocalPlugins, crate::windows::frames::WindowFramePlugin));
         })?;
-        let entities: Vec<Entity> = datasets.iter().map(|d| off.world_mut().spawn((dataset_component(d), transform(d))).id()).collect();
+        let entities: Vec<Entity> = datasets
+            .iter()
+            .map(|d| {
+                let mut e = off.world_mut().spawn((dataset_component(d), transform(d)));
+                if let Some(b) = &d.bricked {
+                    e.insert(b.clone());
+                }
+                e.id()
+            })
+            .collect();
         for (e, d) in entities.iter().zip(datasets) {
             crate::explode::spec::replace_explosion(off.world_mut(), *e, d.explode.as_ref());
         }

@@ -138,14 +138,16 @@ pub fn finish_loads(
                 let entities: Vec<Entity> = datasets
                     .iter()
                     .map(|d| {
-                        commands
-                            .spawn((
-                                d.component(),
-                                Transform::from_matrix(Mat4::from(d.transform)),
-                                DatasetOrigin(d.spec.clone()),
-                                Name::new(d.name.clone()),
-                            ))
-                            .id()
+                        let mut e = commands.spawn((
+                            d.component(),
+                            Transform::from_matrix(Mat4::from(d.transform)),
+                            DatasetOrigin(d.spec.clone()),
+                            Name::new(d.name.clone()),
+                        ));
+                        if let Some(b) = &d.bricked {
+                            e.insert(b.clone());
+                        }
+                        e.id()
                     })
                     .collect();
                 // Exploded datasets get their parts and joints, at rest.

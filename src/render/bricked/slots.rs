@@ -5,27 +5,26 @@
 //! the rest from coarser levels).
 
 use std::collections::HashMap;
+use std::hash::Hash;
 
 use glam::UVec3;
 
-use crate::volume::source::cache::BrickKey;
-
-/// The atlas's slots and which brick each holds.
+/// The atlas's slots and which brick (`K`: a brick of some dataset) each holds.
 #[derive(Clone, Debug)]
-pub struct Slots {
+pub struct Slots<K> {
     /// Slots along each axis.
     pub grid: UVec3,
     /// Texels per slot edge (brick plus apron on both sides).
     pub edge: u32,
-    held: Vec<Option<(BrickKey, u64)>>,
-    by_key: HashMap<BrickKey, u32>,
+    held: Vec<Option<(K, u64)>>,
+    by_key: HashMap<K, u32>,
     frame: u64,
 }
 
-impl Slots {
+impl<K: Copy + Eq + Hash> Slots<K> {
     /// As many slots of `edge` texels as fit a texture of at most `max_texels` per axis
     /// and `budget_bytes` in all (`texel_bytes` each); at least one.
-    pub fn new(edge: u32, max_texels: u32, budget_bytes: u64, texel_bytes: u32) -> Slots {
+    pub fn new(edge: u32, max_texels: u32, budget_bytes: u64, texel_bytes: u32) -> Slots<K> {
         let per_axis = (max_texels / edge.max(1)).max(1);
         let slot_bytes = edge as u64 * edge as u64 * edge as u64 * texel_bytes as u64;
         let count = (budget_bytes / slot_bytes.max(1)).max(1);
@@ -61,7 +60,7 @@ impl Slots {
     }
 
     /// The slot of a resident brick, marked as drawn this frame.
-    pub fn touch(&mut self, key: BrickKey) -> Option<u32> {
+    pub fn touch(&mut self, key: K) -> Option<u32> {
         let slot = *self.by_key.get(&key)?;
         if let Some((_, used)) = &mut self.held[slot as usize] {
             *used = self.frame;
@@ -70,14 +69,14 @@ impl Slots {
     }
 
     /// The slot of a resident brick, without marking it.
-    pub fn slot_of(&self, key: BrickKey) -> Option<u32> {
+    pub fn slot_of(&self, key: K) -> Option<u32> {
         self.by_key.get(&key).copied()
     }
 
     /// A slot for `key`: its own if resident, else a free one, else that of the least
     /// recently drawn brick not drawn this frame (which leaves). `None` when every slot
     /// holds a brick of this frame.
-    pub fn place(&mut self, key: BrickKey) -> Option<(u32, Option<BrickKey>)> {
+    pub fn place(&mut self, key: K) -> Option<(u32, Option<K>)> {
         if let Some(s) = self.touch(key) {
             return Some((s, None));
         }
@@ -103,6 +102,11 @@ impl Slots {
         Some((slot as u32, evicted))
     }
 
+    /// Slots holding a brick.
+    pub fn held(&self) -> usize {
+        self.by_key.len()
+    }
+
     /// Texel origin of a slot in the atlas.
     pub fn origin(&self, slot: u32) -> UVec3 {
         let g = self.grid;
@@ -113,6 +117,7 @@ impl Slots {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::volume::source::cache::BrickKey;
 
     fn key(x: u32) -> BrickKey {
         BrickKey::new(0, UVec3::new(x, 0, 0))
@@ -122,12 +127,12 @@ mod tests {
     fn slots_fill_the_budget_as_a_near_cube() {
         // 34³ texels of 2 bytes = 78 608 bytes per slot; 64 MiB holds 853 slots: grown
         // an axis at a time, 10 × 9 × 9 = 810 (10 × 10 × 9 = 900 is too many).
-        let s = Slots::new(34, 2048, 64 << 20, 2);
+        let s = Slots::<BrickKey>::new(34, 2048, 64 << 20, 2);
         assert_eq!(s.grid, UVec3::new(10, 9, 9));
         assert_eq!(s.texture_size(), UVec3::new(340, 306, 306));
         // The texture size limit wins over the budget.
-        assert_eq!(Slots::new(34, 100, 1 << 40, 1).grid, UVec3::splat(2));
-        assert_eq!(Slots::new(34, 2048, 1, 1).len(), 1);
+        assert_eq!(Slots::<BrickKey>::new(34, 100, 1 << 40, 1).grid, UVec3::splat(2));
+        assert_eq!(Slots::<BrickKey>::new(34, 2048, 1, 1).len(), 1);
         assert_eq!(s.origin(0), UVec3::ZERO);
         assert_eq!(s.origin(10 * 9 + 10 + 2), UVec3::new(2, 1, 1) * 34);
     }

@@ -86,6 +86,8 @@ struct Entry {
 struct State {
     entries: HashMap<BrickKey, Entry>,
     pending: HashSet<BrickKey>,
+    /// Bricks whose load failed: not asked for again (their coarser level is drawn).
+    refused: HashSet<BrickKey>,
     finished: Vec<BrickKey>,
     errors: Vec<(BrickKey, SourceError)>,
     clock: u64,
@@ -165,7 +167,7 @@ impl BrickCache {
                 if self.layout.bricks(level.grid.dims).cmple(k.coords()).any() {
                     continue;
                 }
-                if !s.entries.contains_key(&k) && s.pending.insert(k) {
+                if !s.entries.contains_key(&k) && !s.refused.contains(&k) && s.pending.insert(k) {
                     start.push(k);
                 }
             }
@@ -190,6 +192,7 @@ impl BrickCache {
                     }
                     Err(e) => {
                         s.failed += 1;
+                        s.refused.insert(k);
                         s.errors.push((k, e));
                     }
                 }

@@ -35,6 +35,7 @@ impl MemorySource {
             bits: volume.voxels.bits(),
             levels,
             warnings: Vec::new(),
+            range: Some((volume.stats.min, volume.stats.max)),
         };
         Self { volume, above, info }
     }

@@ -53,6 +53,10 @@ pub struct SourceInfo {
     pub levels: Vec<SourceLevel>,
     /// What had to be interpreted on opening (a channel picked, units assumed, …).
     pub warnings: Vec<String>,
+    /// The real value range of level 0 when the source knows it without reading it all
+    /// (an OME-Zarr display window's min and max, a volume in memory's): what relative
+    /// transfer functions resolve against when only a coarse level is in memory.
+    pub range: Option<(f64, f64)>,
 }
 
 impl SourceInfo {

@@ -70,6 +70,7 @@ impl ProceduralSource {
             bits: 16,
             levels,
             warnings: Vec::new(),
+            range: None,
         };
         Ok(Self { info })
     }

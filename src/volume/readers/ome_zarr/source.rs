@@ -179,6 +179,7 @@ impl ZarrSource {
             bits: 16,
             levels: info_levels,
             warnings,
+            range: meta.window,
         };
         let mut source = ZarrSource { info: info.clone(), levels, encoding: Encoding::U16 };
         let (encoding, values, bits) = source.encoding_for(&data_type, meta.window, &mut info.warnings)?;

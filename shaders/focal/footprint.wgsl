@@ -1,0 +1,39 @@
+#define_import_path focal::footprint
+
+// The pixel footprint of a ray, for the level a bricked region is stepped at
+// (streaming::select chooses the bricks with the same footprint on the CPU): the world
+// distance between this ray and its right and lower neighbours' at its depth (lenses
+// included, so a magnifier's rays step finer), in the volume's own millimetres; level
+// L = ⌊log₂(footprint / level-0 voxel)⌋ clamped to 0 … C, and the step 2^(L − C) of the
+// coarse one.
+
+#import focal::types::Region
+#import focal::bindings::view
+#import focal::camera::Ray
+#import focal::lens::{lens_ray, camera_ray, Spread, spread_of, spread_extent}
+#import focal::bricked::set_bricked_step
+
+var<private> ray_spread: Spread;
+
+fn prepare_ray_footprint(uv: vec2<f32>, ray: Ray) {
+    let px = vec2(1.0 / view.viewport.z, 0.0);
+    let py = vec2(0.0, 1.0 / view.viewport.w);
+    var rx = lens_ray(uv + px);
+    var ry = lens_ray(uv + py);
+    if dot(rx.dir, rx.dir) == 0.0 || dot(ry.dir, ry.dir) == 0.0 {
+        rx = camera_ray(uv + px);
+        ry = camera_ray(uv + py);
+    }
+    ray_spread = spread_of(ray, rx, ry);
+}
+
+// The step factor 2^(L − C) of bricked region r for a ray along dir entering it at t.
+fn bricked_step_at(r: Region, dir: vec3<f32>, t: f32) -> f32 {
+    let depth = ray_spread.depth_start + ray_spread.depth_per_t * t;
+    let native = spread_extent(ray_spread, depth) * length((r.to_native * vec4(dir, 0.0)).xyz);
+    let c = f32(r.bricked.w);
+    let l = clamp(floor(log2(max(native, 1e-30) / r.bricked_scale.y)), 0.0, c);
+    let f = exp2(l - c);
+    set_bricked_step(f);
+    return f;
+}

@@ -1,0 +1,170 @@
+//! The brick atlas on the GPU and the page buffer, updated every frame.
+//!
+//! One 3D texture of [`Slots`] (8-bit, or 16-bit where a bricked source has 16-bit
+//! codes, in the volume atlas's format so both normalise alike) sized by the GPU
+//! budget, and one storage buffer of `u32` words: the slot grid (4), `1 / texture size`
+//! as float bits (3) and a zero, the directory (each bricked volume's tree start), then
+//! the trees ([`PageTree`], child indices relative to their tree). The drawn bricks not
+//! yet in the atlas are uploaded coarse first, at most the budget's per frame; the rest
+//! are drawn from coarser levels until a later frame brings them (the status counts
+//! them, and the headless render waits for none to be left).
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use bevy::prelude::*;
+use bevy::render::render_resource::{
+    Buffer, BufferDescriptor, BufferUsages, Extent3d, Origin3d, TexelCopyBufferLayout, TexelCopyTextureInfo, Texture, TextureAspect,
+    TextureDescriptor, TextureDimension, TextureFormat, TextureUsages, TextureView, TextureViewDescriptor,
+};
+use bevy::render::renderer::{RenderAdapter, RenderDevice, RenderQueue};
+
+use super::page_table::{Page, PageTree};
+use super::slots::Slots;
+use crate::render::extract::ExtractedScene;
+use crate::render::upload::{GpuScene, sixteen_bit_formats, texel16};
+use crate::streaming::bricked::{BrickFrame, StreamStatus};
+use crate::volume::Voxels;
+use crate::volume::source::cache::BrickKey;
+
+/// Words before the directory.
+pub const PAGE_HEADER: usize = 8;
+
+/// A brick of some dataset (its coarse volume's address) in the atlas.
+type SlotKey = (usize, BrickKey);
+
+/// The brick atlas, its slots and the page buffer.
+#[derive(Resource, Default)]
+pub struct BrickAtlas {
+    texture: Option<(Texture, TextureFormat)>,
+    pub view: Option<TextureView>,
+    slots: Option<Slots<SlotKey>>,
+    pub pages: Option<Buffer>,
+    capacity: u64,
+}
+
+impl BrickAtlas {
+    pub fn ready(&self) -> bool {
+        self.view.is_some() && self.pages.is_some()
+    }
+}
+
+fn create_texture(device: &RenderDevice, size: UVec3, format: TextureFormat) -> Texture {
+    device.create_texture(&TextureDescriptor {
+        label: Some("focal brick cache atlas"),
+        size: Extent3d { width: size.x, height: size.y, depth_or_array_layers: size.z },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: TextureDimension::D3,
+        format,
+        usage: TextureUsages::TEXTURE_BINDING | TextureUsages::COPY_DST,
+        view_formats: &[],
+    })
+}
+
+/// Texels of a brick's codes in `format` (8-bit codes as they are; else as the volume
+/// atlas writes them).
+fn texels(voxels: &Voxels, format: TextureFormat) -> Vec<u8> {
+    if format == TextureFormat::R8Unorm {
+        return voxels.as_bytes().to_vec();
+    }
+    (0..voxels.len()).flat_map(|i| texel16(voxels.code(i), voxels.bits(), format)).collect()
+}
+
+/// Places, uploads and tables the bricks the main world drew this frame.
+pub fn upload_bricks(
+    extracted: Option<Res<ExtractedScene>>,
+    gpu: Res<GpuScene>,
+    device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
+    adapter: Res<RenderAdapter>,
+    status: Res<StreamStatus>,
+    mut atlas: ResMut<BrickAtlas>,
+) {
+    let Some(extracted) = extracted else { return };
+    let frames: Vec<(usize, &BrickFrame)> =
+        gpu.bricked_directory.iter().filter_map(|&v| extracted.bricked.get(v).and_then(Option::as_ref).map(|f| (v, f))).collect();
+    let format = if frames.iter().any(|(_, f)| f.bits == 16) { sixteen_bit_formats(&adapter)[0] } else { TextureFormat::R8Unorm };
+    let bpp = if format == TextureFormat::R8Unorm { 1 } else { 2 };
+    let edge = frames.first().map_or(1, |(_, f)| f.layout.stored());
+    let want_slots = !frames.is_empty();
+    let stale = match (&atlas.texture, &atlas.slots) {
+        (Some((_, f)), Some(s)) => *f != format || s.edge != edge || !want_slots && s.len() > 1,
+        _ => true,
+    };
+    if stale {
+        let slots = if want_slots {
+            Slots::new(edge, device.limits().max_texture_dimension_3d, extracted.budget.gpu_bytes, bpp)
+        } else {
+            Slots::new(1, 1, 1, 1)
+        };
+        let texture = create_texture(&device, slots.texture_size(), format);
+        atlas.view = Some(texture.create_view(&TextureViewDescriptor::default()));
+        atlas.texture = Some((texture, format));
+        atlas.slots = Some(slots);
+    }
+    let (Some((texture, _)), Some(mut slots)) = (atlas.texture.clone(), atlas.slots.take()) else { return };
+    slots.next_frame();
+    let size = slots.texture_size().as_vec3();
+    let mut words: Vec<u32> = vec![slots.grid.x, slots.grid.y, slots.grid.z, slots.edge];
+    words.extend((1.0 / size).to_array().map(f32::to_bits));
+    words.push(0);
+    let dir_at = words.len();
+    words.resize(dir_at + frames.len(), 0);
+    let (mut uploads, mut not_uploaded) = (0usize, 0usize);
+    for (i, (v, frame)) in frames.iter().enumerate() {
+        let id = extracted.scene.volumes.get(*v).map_or(0, |a| Arc::as_ptr(a) as usize);
+        let mut drawn: HashMap<BrickKey, Page> = frame.empty.iter().map(|(k, c)| (*k, Page::Empty(*c))).collect();
+        for (k, data) in frame.drawn.iter() {
+            if let Some(s) = slots.touch((id, *k)) {
+                drawn.insert(*k, Page::Slot(s));
+                continue;
+            }
+            if uploads >= extracted.budget.uploads_per_frame {
+                not_uploaded += 1;
+                continue;
+            }
+            let Some((s, _)) = slots.place((id, *k)) else {
+                // Every slot holds a brick of this frame: the rest are drawn coarser.
+                continue;
+            };
+            let o = slots.origin(s);
+            let n = frame.layout.stored();
+            queue.write_texture(
+                TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: Origin3d { x: o.x, y: o.y, z: o.z },
+                    aspect: TextureAspect::All,
+                },
+                &texels(&data.voxels, format),
+                TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(n * bpp), rows_per_image: Some(n) },
+                Extent3d { width: n, height: n, depth_or_array_layers: n },
+            );
+            uploads += 1;
+            drawn.insert(*k, Page::Slot(s));
+        }
+        let tree = PageTree::build(&frame.table_dims, frame.layout, &drawn);
+        words[dir_at + i] = words.len() as u32;
+        words.extend(tree.words);
+    }
+    status.update(|c| {
+        c.on_gpu = slots.held();
+        c.not_uploaded = not_uploaded;
+    });
+    atlas.slots = Some(slots);
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    if atlas.pages.is_none() || atlas.capacity < bytes.len() as u64 {
+        let capacity = (bytes.len() as u64).next_power_of_two().max(256);
+        atlas.pages = Some(device.create_buffer(&BufferDescriptor {
+            label: Some("focal page tables"),
+            size: capacity,
+            usage: BufferUsages::STORAGE | BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        }));
+        atlas.capacity = capacity;
+    }
+    if let Some(pages) = &atlas.pages {
+        queue.write_buffer(pages, 0, &bytes);
+    }
+}

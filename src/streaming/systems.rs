@@ -1,0 +1,126 @@
+//! The streaming system: each frame, for every bricked volume of the scene, the bricks
+//! the views want ([`super::select::wanted`]) are asked of its cache (coarse first; the
+//! cache loads them on its threads and never blocks the frame), and the renderer is told
+//! which resident ones to draw: the wanted bricks and their ancestors that are in memory,
+//! those whose codes every look using the volume shows as transparent marked empty.
+
+use std::collections::BTreeSet;
+
+use bevy::prelude::*;
+use glam::Affine3A;
+
+use super::bricked::{BrickFrame, BrickedDataset, BrickedScene, StreamBudget, StreamStatus};
+use super::select::{Magnified, Seen, ViewFrame, wanted};
+use crate::dataset::{Dataset, SceneRegions, VolumeView};
+use crate::lens::ViewLenses;
+use crate::lens::stack::Effect;
+use crate::region::RenderScene;
+use crate::volume::source::cache::BrickKey;
+
+/// The views of volume cameras this frame.
+pub fn view_frames(views: &Query<(&ViewLenses, &VolumeView)>) -> Vec<ViewFrame> {
+    views
+        .iter()
+        .filter_map(|(l, _)| {
+            let (camera, screen) = (l.camera?, l.screen?);
+            let magnifiers = l
+                .lenses
+                .iter()
+                .filter_map(|r| match &r.effect {
+                    Effect::Magnifier(m) => {
+                        Some(Magnified { center: r.center, reach: r.radius + r.border, magnification: m.magnification })
+                    }
+                    _ => None,
+                })
+                .collect();
+            Some(ViewFrame { camera, screen, magnifiers })
+        })
+        .collect()
+}
+
+/// The regions of `scene` that show volume `v`, as the selection sees them.
+fn seen_by(scene: &RenderScene, v: usize, coarse_index_to_dataset: Affine3A) -> Vec<Seen> {
+    let dataset_from_index = coarse_index_to_dataset.inverse();
+    scene
+        .regions
+        .iter()
+        .filter(|r| r.volume == v)
+        .map(|r| Seen { dataset_to_world: r.world_to_voxel.inverse() * dataset_from_index, planes: r.planes.clone() })
+        .collect()
+}
+
+/// Asks for the bricks the views want and publishes what to draw ([`BrickedScene`]).
+pub fn stream_bricks(
+    datasets: Query<(&Dataset, &BrickedDataset)>,
+    regions: Res<SceneRegions>,
+    views: Query<(&ViewLenses, &VolumeView)>,
+    budget: Res<StreamBudget>,
+    status: Res<StreamStatus>,
+    mut out: ResMut<BrickedScene>,
+) {
+    let scene = &regions.scene;
+    let frames = view_frames(&views);
+    let mut volumes = vec![None; scene.volumes.len()];
+    let (mut want_total, mut resident_total, mut pending, mut failed, mut finest, mut count) = (0, 0, 0, 0, None::<usize>, 0);
+    for (v, entity) in regions.datasets.iter().enumerate() {
+        let Ok((dataset, bricked)) = datasets.get(*entity) else { continue };
+        let Some(volume) = scene.volumes.get(v) else { continue };
+        let bits = bricked.bits();
+        count += 1;
+        let per_brick = bricked.cache.layout().stored().pow(3) as u64 * (bits as u64 / 8);
+        let cap = budget.gpu_bricks(bits).min((budget.cpu_bytes / per_brick.max(1)) as usize) * 3 / 4;
+        let seen = seen_by(scene, v, volume.grid.world_to_index().inverse());
+        let want = wanted(&bricked.levels, bricked.coarse, bricked.cache.layout(), &seen, &frames, cap.max(1));
+        bricked.cache.request(&want);
+        finest = want.iter().map(|k| k.level as usize).min().into_iter().chain(finest).min();
+        // The wanted bricks and their ancestors below the coarse level, coarse first.
+        let mut keys: BTreeSet<(std::cmp::Reverse<u8>, BrickKey)> = BTreeSet::new();
+        for k in &want {
+            let mut a = *k;
+            while (a.level as usize) < bricked.coarse && keys.insert((std::cmp::Reverse(a.level), a)) {
+                a = a.parent();
+            }
+        }
+        let looks: Vec<_> = scene.regions.iter().filter(|r| r.volume == v).filter_map(|r| scene.appearances.get(r.appearance)).collect();
+        let tests: Option<Vec<_>> = looks.iter().map(|a| a.code_visibility(volume)).collect();
+        let (mut drawn, mut empty) = (Vec::new(), Vec::new());
+        for (_, k) in keys {
+            let Some(data) = bricked.cache.get(k) else { continue };
+            let invisible = tests.as_ref().is_some_and(|t| !t.is_empty() && t.iter().all(|f| !f(data.range.0, data.range.1)));
+            if invisible {
+                empty.push((k, data.range.0));
+            } else {
+                drawn.push((k, data));
+            }
+        }
+        let present: std::collections::HashSet<BrickKey> = drawn.iter().map(|(k, _)| *k).chain(empty.iter().map(|(k, _)| *k)).collect();
+        let resident = want.iter().filter(|k| present.contains(k)).count();
+        let stats = bricked.cache.stats();
+        want_total += want.len();
+        resident_total += resident;
+        pending += stats.pending;
+        failed += stats.failed;
+        for (k, e) in bricked.cache.errors() {
+            warn!("{}: brick {:?} of level {}: {e}; drawn from a coarser level", dataset.volume.name, k.brick, k.level);
+        }
+        volumes[v] = Some(BrickFrame {
+            table_dims: bricked.table_dims(),
+            layout: bricked.cache.layout(),
+            coarse: bricked.coarse,
+            bits,
+            complete: resident == want.len(),
+            drawn: std::sync::Arc::new(drawn),
+            empty: std::sync::Arc::new(empty),
+        });
+    }
+    status.update(|c| {
+        c.bricked = count;
+        c.views = frames.len();
+        c.wanted = want_total;
+        c.resident = resident_total;
+        c.pending = pending;
+        c.failed = failed;
+        c.finest_wanted = finest;
+    });
+    out.volumes = volumes;
+}
