@@ -83,6 +83,9 @@ pub struct RenderArgs {
     /// κs of the context-preserving mode: how sharp the transition is.
     #[arg(long)]
     kappa_s: Option<f32>,
+    /// Print the process's peak resident memory when done (`peak resident memory: N MiB`).
+    #[arg(long)]
+    report_memory: bool,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -94,6 +97,24 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
+    let result = render(args);
+    if args.report_memory {
+        match peak_resident_mib() {
+            Some(mib) => eprintln!("peak resident memory: {mib:.0} MiB"),
+            None => eprintln!("peak resident memory: unknown (no /proc/self/status)"),
+        }
+    }
+    result
+}
+
+/// Peak resident set of this process (`VmHWM`), MiB.
+fn peak_resident_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kb: f64 = status.lines().find_map(|l| l.strip_prefix("VmHWM:"))?.trim().trim_end_matches("kB").trim().parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+fn render(args: &RenderArgs) -> Result<(), String> {
     let size = args.size.as_deref().map(parse_size).transpose()?;
     let options = |out_dir: PathBuf| RunOptions { out_dir, cpu: args.cpu, size };
     let scenes: Vec<&PathBuf> = args.inputs.iter().filter(|p| p.extension().is_some_and(|e| e == "ron")).collect();

@@ -206,6 +206,23 @@ impl Offscreen {
         Err("the GPU produced no image".into())
     }
 
+    /// Runs frames until the volumes are drawn once (whatever streaming has brought by
+    /// then); the frames it took.
+    pub fn first_frame(&mut self) -> Result<u32, String> {
+        let progress = self.app.world().get_resource::<super::RenderProgress>().cloned().ok_or("no renderer")?;
+        let before = progress.volumes_drawn();
+        for k in 1..=MAX_WAIT_FRAMES {
+            self.update();
+            if let Some(e) = self.pipeline_error() {
+                return Err(e);
+            }
+            if self.ready() && progress.volumes_drawn() > before {
+                return Ok(k);
+            }
+        }
+        Err("the ray caster did not get ready (no volume uploaded or no pipeline)".into())
+    }
+
     /// Runs frames until every brick the view wants is drawn (bricked datasets), at most
     /// [`STREAM_WAIT`]; a picture that did not converge is logged.
     pub fn wait_for_streaming(&mut self) -> bool {
@@ -213,6 +230,16 @@ impl Offscreen {
         let start = Instant::now();
         loop {
             if status.converged() {
+                let c = status.counts();
+                if c.bricked > 0 {
+                    info!(
+                        "streaming converged after {:.2} s: {} bricks wanted (finest level {}), {} on the GPU",
+                        start.elapsed().as_secs_f32(),
+                        c.wanted,
+                        c.finest_wanted.map_or("-".into(), |l| l.to_string()),
+                        c.on_gpu
+                    );
+                }
                 return true;
             }
             if start.elapsed() > STREAM_WAIT {

@@ -36,9 +36,27 @@ pub struct StreamBudget {
     pub uploads_per_frame: usize,
 }
 
+/// Environment variables that set the budgets in MiB (decoded bricks per dataset, the
+/// GPU atlas).
+pub const CPU_BUDGET_VAR: &str = "FOCAL_CACHE_MB";
+pub const GPU_BUDGET_VAR: &str = "FOCAL_GPU_CACHE_MB";
+
 impl Default for StreamBudget {
+    /// 512 MiB of decoded bricks, a 256 MiB GPU atlas, 64 uploads a frame; the budgets
+    /// from [`CPU_BUDGET_VAR`] and [`GPU_BUDGET_VAR`] where set (a value that is not a
+    /// number of MiB ≥ 1 is ignored with a warning).
     fn default() -> Self {
-        Self { cpu_bytes: 512 << 20, gpu_bytes: 256 << 20, uploads_per_frame: 64 }
+        let mib = |var: &str, default: u64| match std::env::var(var) {
+            Ok(v) => match v.trim().parse::<u64>() {
+                Ok(n) if n >= 1 => n << 20,
+                _ => {
+                    warn!("{var}={v} is not a number of MiB: {} MiB used", default >> 20);
+                    default
+                }
+            },
+            Err(_) => default,
+        };
+        Self { cpu_bytes: mib(CPU_BUDGET_VAR, 512 << 20), gpu_bytes: mib(GPU_BUDGET_VAR, 256 << 20), uploads_per_frame: 64 }
     }
 }
 
@@ -88,9 +106,16 @@ impl BrickedDataset {
             .unwrap_or(info.levels.len() - 1)
             .max(1);
         let (mut volume, faults) = read_level(source.as_ref(), coarse, &|_| {}).map_err(|e| e.to_string())?;
-        // A coarse level's means span less than the data: looks resolve against the
-        // source's own range where it knows it.
-        if let Some((lo, hi)) = info.range.filter(|(lo, hi)| lo.is_finite() && hi.is_finite() && lo <= hi) {
+        // A coarse level's means span less than the data, and a look's table covers the
+        // dataset's range (values past it take its edge): the source's own range where it
+        // knows it, else every code's.
+        let codes = {
+            let (a, b) = (info.values.to_real(0.0), info.values.to_real(info.code_max() as f64));
+            (a.min(b), a.max(b))
+        };
+        let range = info.range.filter(|(lo, hi)| lo.is_finite() && hi.is_finite() && lo <= hi).unwrap_or(codes);
+        {
+            let (lo, hi) = range;
             volume.stats.min = volume.stats.min.min(lo);
             volume.stats.max = volume.stats.max.max(hi);
         }

@@ -112,9 +112,22 @@ impl Bench {
         appearance: Appearance,
         count: usize,
         orbit: bool,
-        mut set: impl FnMut(&mut Offscreen, usize),
+        set: impl FnMut(&mut Offscreen, usize),
     ) -> Result<(Vec<f64>, Vec<image::RgbaImage>), String> {
         let (camera, centre) = self.place(volume, appearance);
+        self.rounds(camera, centre, count, orbit, set)
+    }
+
+    /// The rounds of [`Self::interleaved_by`] over what the view shows now, seen by
+    /// `camera` (orbiting about `centre` with `orbit`).
+    pub(super) fn rounds(
+        &mut self,
+        camera: focal::region::Camera,
+        centre: Vec3,
+        count: usize,
+        orbit: bool,
+        mut set: impl FnMut(&mut Offscreen, usize),
+    ) -> Result<(Vec<f64>, Vec<image::RgbaImage>), String> {
         let mut turn = 0u32;
         // Every configuration once first (pipelines, atlases), and its picture.
         let mut images = Vec::new();

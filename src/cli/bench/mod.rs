@@ -15,7 +15,9 @@
 //! showing the dataset as it is, goals ≤ ×1.10 and ≤ ×1.33; the cutaway, the windows of
 //! the paper's figures 3–6, a window over the head without clip, two halves),
 //! `--explode` (exploded views, [`explode`]: the paper's table 1, 1 to 64 parts at rest
-//! and exploded against the plain ray caster; goal ≥ 80 % at 64 parts). Each line
+//! and exploded against the plain ray caster; goal ≥ 80 % at 64 parts), `--bricked`
+//! (streaming brick by brick, [`bricked`]: orbiting a source 8× the cache against the
+//! chosen level in memory, a magnifier over it, the first frame of 8192³, peak memory). Each line
 //! ends with the ratio against its group's baseline; `--json` prints the same as JSON,
 //! `--save DIR` writes each configuration's picture, and `FOCAL_BENCH_SAMPLES=1` prints
 //! every timed frame (frame times on llvmpipe scatter by ±15 %: time enough frames).
@@ -36,6 +38,7 @@ use focal::transfer::{LabelTransfer, presets};
 use focal::volume::phantom::{self, Phantom};
 use serde_json::json;
 
+mod bricked;
 mod explode;
 mod harness;
 mod windows;
@@ -77,6 +80,9 @@ pub struct BenchArgs {
     /// Only the exploded views group (the paper's table 1).
     #[arg(long)]
     explode: bool,
+    /// Only the bricked-streaming group (issue 23).
+    #[arg(long)]
+    bricked: bool,
     /// With --explode: only these part counts (1, 2, 4, 8, 16, 32, 64; comma-separated).
     #[arg(long, value_delimiter = ',', value_name = "N,...")]
     parts: Vec<usize>,
@@ -95,8 +101,15 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         .split_once('x')
         .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
         .ok_or_else(|| format!("size '{}' is not WIDTHxHEIGHT", args.size))?;
-    let all =
-        !(args.skipping || args.termination || args.modes || args.lenses || args.context || args.twolevel || args.windows || args.explode);
+    let all = !(args.skipping
+        || args.termination
+        || args.modes
+        || args.lenses
+        || args.context
+        || args.twolevel
+        || args.windows
+        || args.explode
+        || args.bricked);
     let off = Offscreen::new(w, h, |app| {
         app.add_plugins(FocalPlugins);
     })?;
@@ -218,6 +231,10 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
 
     if all || args.explode {
         explode::group(&mut bench, &mut rows, args.resolution, &args.parts)?;
+    }
+
+    if all || args.bricked {
+        bricked::group(&mut bench, &mut rows)?;
     }
 
     if all || args.lenses {
