@@ -8,7 +8,7 @@
 // kept per ray (consecutive samples mostly stay in one brick).
 
 #import focal::types::Region
-#import focal::bindings::pages
+#import focal::bindings::{pages, brick_cache, volume_sampler}
 
 const BRICKED_COARSE: u32 = 0u;
 const BRICKED_EMPTY: u32 = 1u;
@@ -28,6 +28,15 @@ var<private> bc_level: u32 = 0u;
 var<private> bc_dims: vec3<f32>;
 var<private> bc_shift: vec3<f32>;
 var<private> bc_code: f32 = 0.0;
+// A brick's visible 8³ sub-blocks (bit x + 4y + 16z) and its owned box's origin in
+// level-k voxels (b·B).
+var<private> bc_mask: vec2<u32>;
+var<private> bc_origin: vec3<f32>;
+// 1 / the brick atlas's size (from the page buffer's header, read at a look-up).
+var<private> bc_inv: vec3<f32>;
+// Words per node (render::bricked::page_table::NODE) and the sub-block edge.
+const NODE: u32 = 4u;
+const SUB_BLOCK: f32 = 8.0;
 // The ray's step at its level over the coarse step, 2^(L − C) (set per ray).
 var<private> bricked_step: f32 = 1.0;
 
@@ -73,7 +82,7 @@ fn bricked_locate(r: Region, q0: vec3<f32>) {
     var k = top;
     var dims = level_dims(tree, k);
     var b = brick_at(q0, k, dims, size);
-    var node = tree + 4u + 4u * (top + 1u) + 2u * ((b.z * tb.y + b.y) * tb.x + b.x);
+    var node = tree + 4u + 4u * (top + 1u) + NODE * ((b.z * tb.y + b.y) * tb.x + b.x);
     bc_kind = BRICKED_COARSE;
     for (var i = 0u; i <= top; i++) {
         let page = pages[node];
@@ -89,6 +98,9 @@ fn bricked_locate(r: Region, q0: vec3<f32>) {
             bc_level = k;
             bc_dims = vec3<f32>(dims);
             bc_shift = origin + f32(r.bricked.z) + 0.5 - vec3<f32>(b * size);
+            bc_mask = vec2<u32>(pages[node + 2u], pages[node + 3u]);
+            bc_origin = vec3<f32>(b * size);
+            bc_inv = vec3(bitcast<f32>(pages[4]), bitcast<f32>(pages[5]), bitcast<f32>(pages[6]));
         }
         let children = pages[node + 1u];
         if children == 0u || k == 0u {
@@ -97,7 +109,7 @@ fn bricked_locate(r: Region, q0: vec3<f32>) {
         let below = level_dims(tree, k - 1u);
         let bb = brick_at(q0, k - 1u, below, size);
         let c = min(select(bb - 2u * b, vec3(0u), bb < 2u * b), vec3(1u));
-        node = tree + children + 2u * (c.x + 2u * c.y + 4u * c.z);
+        node = tree + children + NODE * (c.x + 2u * c.y + 4u * c.z);
         k -= 1u;
         dims = below;
         b = bb;
@@ -108,6 +120,11 @@ fn bricked_locate(r: Region, q0: vec3<f32>) {
     bc_lo = select(vec3<f32>(b) * span - 0.5, vec3(-3.4e38), b == vec3(0u));
     bc_hi = select(vec3<f32>(b + 1u) * span - 0.5, vec3(3.4e38), b + 1u >= n);
     bc_entry = r.bricked.x;
+}
+
+// After bricked_locate of a brick: the atlas texture coordinate of q0.
+fn bricked_uvw(q0: vec3<f32>) -> vec3<f32> {
+    return bricked_texel(q0) * bc_inv;
 }
 
 // After bricked_locate: the atlas texel of q0 in the located brick.
@@ -130,4 +147,57 @@ fn bricked_box_exit(r: Region, qc: vec3<f32>, qd: vec3<f32>, t: f32, coarse_exit
         }
     }
     return min(t + max(exit, 0.0), coarse_exit);
+}
+
+// After bricked_locate of a brick: its sub-block holding q0 (level-k voxels of its lower
+// corner).
+fn sub_block_at(q0: vec3<f32>) -> vec3<f32> {
+    let qk = clamp((q0 + 0.5) / f32(1u << bc_level) - 0.5, vec3(0.0), bc_dims - 1.0);
+    return clamp(floor((qk + 0.5 - bc_origin) / SUB_BLOCK), vec3(0.0), vec3(3.0));
+}
+
+// After bricked_locate of a brick: whether q0's sub-block holds anything visible.
+fn sub_block_visible(q0: vec3<f32>) -> bool {
+    let s = vec3<u32>(sub_block_at(q0));
+    let bit = s.x + 4u * s.y + 16u * s.z;
+    let word = select(bc_mask.x, bc_mask.y, bit >= 32u);
+    return ((word >> (bit % 32u)) & 1u) != 0u;
+}
+
+// After bricked_locate of a brick: the ray parameter where it leaves q0's sub-block
+// (coarse index qc, voxels qd per unit t), at most `limit`.
+fn sub_block_exit(r: Region, q0: vec3<f32>, qc: vec3<f32>, qd: vec3<f32>, t: f32, limit: f32) -> f32 {
+    let lo_k = bc_origin + sub_block_at(q0) * SUB_BLOCK - 0.5;
+    let f = f32(1u << bc_level) / r.bricked_scale.x;
+    let lo = (lo_k + 0.5) * f - 0.5;
+    let hi = (lo_k + SUB_BLOCK + 0.5) * f - 0.5;
+    var exit = 3.4e38;
+    for (var a = 0; a < 3; a++) {
+        if qd[a] > 1e-12 {
+            exit = min(exit, (hi[a] - qc[a]) / qd[a]);
+        } else if qd[a] < -1e-12 {
+            exit = min(exit, (lo[a] - qc[a]) / qd[a]);
+        }
+    }
+    return min(t + max(exit, 0.0), limit);
+}
+
+// After bricked_locate of a brick: the central-difference gradient at q0 from that brick
+// alone (its apron of 2 holds every filter tap of the neighbours one voxel away), as
+// sampling::index_gradient takes it: differences over `h` coarse voxels (h = 2^(L − C),
+// one voxel of the ray's level L), here h·2^(C − k) voxels of the brick's level k, at
+// most one (beyond, the difference is scaled to the same span).
+fn bricked_gradient(r: Region, q0: vec3<f32>, h: f32) -> vec3<f32> {
+    let qk = clamp((q0 + 0.5) / f32(1u << bc_level) - 0.5, vec3(0.0), bc_dims - 1.0);
+    let want = h * r.bricked_scale.x / f32(1u << bc_level);
+    let d = min(want, 1.0);
+    var g = vec3(0.0);
+    for (var a = 0; a < 3; a++) {
+        var e = vec3(0.0);
+        e[a] = d;
+        let hi = clamp(qk + e, vec3(0.0), bc_dims - 1.0) + bc_shift;
+        let lo = clamp(qk - e, vec3(0.0), bc_dims - 1.0) + bc_shift;
+        g[a] = textureSampleLevel(brick_cache, volume_sampler, hi * bc_inv, 0.0).r - textureSampleLevel(brick_cache, volume_sampler, lo * bc_inv, 0.0).r;
+    }
+    return 0.5 * g * (want / d);
 }

@@ -6,8 +6,8 @@
 // and min-max (reference: volume::sample, volume::bricks).
 
 #import focal::types::{Region, REGION_LABELS}
-#import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy, lut_atlas, brick_cache, pages}
-#import focal::bricked::{is_bricked, level_zero, bricked_locate, bricked_texel, bricked_box_exit, bricked_step_factor, bc_kind, bc_code, BRICKED_TEXEL, BRICKED_EMPTY}
+#import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy, lut_atlas, brick_cache}
+#import focal::bricked::{is_bricked, level_zero, bricked_locate, bricked_texel, bricked_uvw, bricked_box_exit, bricked_step_factor, sub_block_visible, sub_block_exit, bricked_gradient, bc_kind, bc_code, BRICKED_TEXEL, BRICKED_EMPTY}
 
 // Mip level the samples come from: set per sample under lenses with anti-aliasing
 // (focal::lens::update_lod), 0 otherwise (reference: PreparedRegion::sample).
@@ -68,18 +68,13 @@ fn trilinear_memory(r: Region, q: vec3<f32>) -> f32 {
 #endif
 }
 
-// 1 / the brick atlas's size, from the page buffer's header.
-fn cache_inv_size() -> vec3<f32> {
-    return vec3(bitcast<f32>(pages[4]), bitcast<f32>(pages[5]), bitcast<f32>(pages[6]));
-}
-
 // Sample of a bricked region: the finest drawn brick holding q, an empty brick's lowest
 // code (invisible under every look of the volume), else the coarse volume.
 fn bricked_sample(r: Region, q: vec3<f32>) -> f32 {
     let q0 = level_zero(r, q);
     bricked_locate(r, q0);
     if bc_kind == BRICKED_TEXEL {
-        return textureSampleLevel(brick_cache, volume_sampler, bricked_texel(q0) * cache_inv_size(), 0.0).r;
+        return textureSampleLevel(brick_cache, volume_sampler, bricked_uvw(q0), 0.0).r;
     }
     if bc_kind == BRICKED_EMPTY {
         return bc_code / r.dims.w;
@@ -164,6 +159,11 @@ fn index_gradient(r: Region, q: vec3<f32>, atlas_width: u32) -> vec3<f32> {
 #ifdef HAS_BRICKED
     if is_bricked(r) {
         h = bricked_step_factor();
+        let q0 = level_zero(r, q);
+        bricked_locate(r, q0);
+        if bc_kind == BRICKED_TEXEL {
+            return bricked_gradient(r, q0, h);
+        }
     }
 #endif
     for (var a = 0; a < 3; a++) {
@@ -184,12 +184,13 @@ fn brick_of(r: Region, q: vec3<f32>) -> vec3<u32> {
 fn brick_occupied(r: Region, q: vec3<f32>) -> bool {
 #ifdef HAS_BRICKED
     if is_bricked(r) {
-        bricked_locate(r, level_zero(r, q));
+        let q0 = level_zero(r, q);
+        bricked_locate(r, q0);
         if bc_kind == BRICKED_EMPTY {
             return false;
         }
         if bc_kind == BRICKED_TEXEL {
-            return true;
+            return sub_block_visible(q0);
         }
     }
 #endif
@@ -215,8 +216,13 @@ fn brick_exit(r: Region, q: vec3<f32>, qd: vec3<f32>, t: f32) -> f32 {
     }
 #ifdef HAS_BRICKED
     if is_bricked(r) {
-        bricked_locate(r, level_zero(r, q));
-        return bricked_box_exit(r, q, qd, t, t + max(exit, 0.0));
+        let q0 = level_zero(r, q);
+        bricked_locate(r, q0);
+        let limit = bricked_box_exit(r, q, qd, t, t + max(exit, 0.0));
+        if bc_kind == BRICKED_TEXEL {
+            return sub_block_exit(r, q0, q, qd, t, bricked_box_exit(r, q, qd, t, 3.4e38));
+        }
+        return limit;
     }
 #endif
     return t + max(exit, 0.0);

@@ -19,8 +19,9 @@ use crate::volume::source::cache::{BrickCache, BrickData, BrickKey};
 use crate::volume::source::level::read_level;
 use crate::volume::source::{SourceLevel, VoxelSource};
 
-/// Bricks of 32³ voxels with a one-voxel apron for trilinear filtering.
-pub const BRICK: BrickLayout = BrickLayout::new(32, 1);
+/// Bricks of 32³ voxels with an apron of two: trilinear filtering anywhere in the brick,
+/// and the gradient's neighbours one voxel away, read the brick alone.
+pub const BRICK: BrickLayout = BrickLayout::new(32, 2);
 
 /// Most voxels of the coarse level read whole (64³).
 pub const COARSE_VOXELS: u64 = 1 << 18;
@@ -153,8 +154,9 @@ pub struct BrickFrame {
     pub coarse: usize,
     /// Bits per code.
     pub bits: u32,
-    /// Bricks to draw that hold something visible, coarse first, with their codes.
-    pub drawn: Arc<Vec<(BrickKey, Arc<BrickData>)>>,
+    /// Bricks to draw that hold something visible, coarse first, with their codes and
+    /// which of their 8³ sub-blocks do (bit `x + 4y + 16z`).
+    pub drawn: Arc<Vec<(BrickKey, Arc<BrickData>, u64)>>,
     /// Bricks to draw whose codes are all invisible (skipped, never uploaded), with
     /// their lowest code.
     pub empty: Arc<Vec<(BrickKey, u16)>>,

@@ -86,14 +86,19 @@ pub fn stream_bricks(
         let (mut drawn, mut empty) = (Vec::new(), Vec::new());
         for (_, k) in keys {
             let Some(data) = bricked.cache.get(k) else { continue };
-            let invisible = tests.as_ref().is_some_and(|t| !t.is_empty() && t.iter().all(|f| !f(data.range.0, data.range.1)));
-            if invisible {
+            let shows = |(lo, hi): (u16, u16)| tests.as_ref().is_none_or(|t| t.is_empty() || t.iter().any(|f| f(lo, hi)));
+            let mask = if shows(data.range) {
+                data.sub_ranges.iter().enumerate().filter(|(_, r)| shows(**r)).fold(0u64, |m, (i, _)| m | 1 << i)
+            } else {
+                0
+            };
+            if mask == 0 {
                 empty.push((k, data.range.0));
             } else {
-                drawn.push((k, data));
+                drawn.push((k, data, mask));
             }
         }
-        let present: std::collections::HashSet<BrickKey> = drawn.iter().map(|(k, _)| *k).chain(empty.iter().map(|(k, _)| *k)).collect();
+        let present: std::collections::HashSet<BrickKey> = drawn.iter().map(|(k, ..)| *k).chain(empty.iter().map(|(k, _)| *k)).collect();
         let resident = want.iter().filter(|k| present.contains(k)).count();
         let stats = bricked.cache.stats();
         want_total += want.len();

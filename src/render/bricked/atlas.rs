@@ -114,10 +114,10 @@ pub fn upload_bricks(
     let (mut uploads, mut not_uploaded) = (0usize, 0usize);
     for (i, (v, frame)) in frames.iter().enumerate() {
         let id = extracted.scene.volumes.get(*v).map_or(0, |a| Arc::as_ptr(a) as usize);
-        let mut drawn: HashMap<BrickKey, Page> = frame.empty.iter().map(|(k, c)| (*k, Page::Empty(*c))).collect();
-        for (k, data) in frame.drawn.iter() {
+        let mut drawn: HashMap<BrickKey, (Page, u64)> = frame.empty.iter().map(|(k, c)| (*k, (Page::Empty(*c), 0))).collect();
+        for (k, data, mask) in frame.drawn.iter() {
             if let Some(s) = slots.touch((id, *k)) {
-                drawn.insert(*k, Page::Slot(s));
+                drawn.insert(*k, (Page::Slot(s), *mask));
                 continue;
             }
             if uploads >= extracted.budget.uploads_per_frame {
@@ -142,7 +142,7 @@ pub fn upload_bricks(
                 Extent3d { width: n, height: n, depth_or_array_layers: n },
             );
             uploads += 1;
-            drawn.insert(*k, Page::Slot(s));
+            drawn.insert(*k, (Page::Slot(s), *mask));
         }
         let tree = PageTree::build(&frame.table_dims, frame.layout, &drawn);
         words[dir_at + i] = words.len() as u32;

@@ -5,9 +5,11 @@
 //! holds one node for every brick of level `T = C − 1` (the top grid), and below any
 //! node with a drawn descendant a block of its eight children (bricks nest: brick `b` of
 //! level `k` holds bricks `2b + o` of level `k − 1`, since `q_k = (q + ½)/2ᵏ − ½`,
-//! [`crate::volume::pyramid::level_index`]). A node is two words: its [`Page`] (`slot +
-//! 2`, [`EMPTY_PAGE`] with the lowest code, `0` missing) and the word index of its child
-//! block (`0` none).
+//! [`crate::volume::pyramid::level_index`]). A node is four words: its [`Page`] (`slot +
+//! 2`, [`EMPTY_PAGE`] with the lowest code, `0` missing), the word index of its child
+//! block (`0` none), and for a brick in a slot the 64 bits of its 8³ sub-blocks that
+//! hold something visible (bit `x + 4y + 16z`; empty-space skipping at the granularity
+//! a volume in memory has).
 //!
 //! A sample at continuous level-0 index `q` descends from the top node holding it while
 //! nodes have children, keeping the last page that is not missing: the finest drawn brick
@@ -63,6 +65,18 @@ impl Page {
     }
 }
 
+/// Words per node: page, child block, sub-block mask (two words).
+pub const NODE: usize = 4;
+
+fn write_node(words: &mut [u32], at: usize, node: Option<&(Page, u64)>) {
+    let (page, mask) = node.copied().unwrap_or((Page::Missing, 0));
+    words[at] = page.code();
+    if let Page::Slot(_) = page {
+        words[at + 2] = mask as u32;
+        words[at + 3] = (mask >> 32) as u32;
+    }
+}
+
 /// Words before the nodes: `T`, the top grid (3), and four per level `0 … T`.
 pub fn header_words(top: usize) -> usize {
     4 + 4 * (top + 1)
@@ -87,8 +101,8 @@ pub enum Located {
 
 impl PageTree {
     /// The tree over levels of `dims` (`0 … T`, the coarse level left out) drawing the
-    /// bricks of `drawn`.
-    pub fn build(dims: &[UVec3], layout: BrickLayout, drawn: &HashMap<BrickKey, Page>) -> PageTree {
+    /// bricks of `drawn` (each with its sub-block mask).
+    pub fn build(dims: &[UVec3], layout: BrickLayout, drawn: &HashMap<BrickKey, (Page, u64)>) -> PageTree {
         let top = dims.len().saturating_sub(1);
         let mut words = Vec::new();
         if dims.is_empty() {
@@ -112,15 +126,15 @@ impl PageTree {
         }
         let first = words.len();
         let n = (top_bricks.x * top_bricks.y * top_bricks.z) as usize;
-        words.resize(first + 2 * n, 0);
+        words.resize(first + NODE * n, 0);
         // Breadth-first: (node word, key) whose children are still to place.
         let mut queue = Vec::new();
         for z in 0..top_bricks.z {
             for y in 0..top_bricks.y {
                 for x in 0..top_bricks.x {
                     let key = BrickKey::new(top, UVec3::new(x, y, z));
-                    let at = first + 2 * ((z * top_bricks.y + y) * top_bricks.x + x) as usize;
-                    words[at] = drawn.get(&key).copied().unwrap_or(Page::Missing).code();
+                    let at = first + NODE * ((z * top_bricks.y + y) * top_bricks.x + x) as usize;
+                    write_node(&mut words, at, drawn.get(&key));
                     if inner.contains(&key) {
                         queue.push((at, key));
                     }
@@ -130,7 +144,7 @@ impl PageTree {
         while let Some((at, key)) = queue.pop() {
             let block = words.len();
             words[at + 1] = block as u32;
-            words.resize(block + 16, 0);
+            words.resize(block + 8 * NODE, 0);
             let level = key.level as usize - 1;
             let limit = layout.bricks(dims[level]);
             for o in 0..8u32 {
@@ -139,8 +153,8 @@ impl PageTree {
                     continue;
                 }
                 let child = BrickKey::new(level, c);
-                let w = block + 2 * o as usize;
-                words[w] = drawn.get(&child).copied().unwrap_or(Page::Missing).code();
+                let w = block + NODE * o as usize;
+                write_node(&mut words, w, drawn.get(&child));
                 if inner.contains(&child) {
                     queue.push((w, child));
                 }
@@ -163,7 +177,7 @@ impl PageTree {
         };
         let tb = UVec3::new(w(1), w(2), w(3));
         let b = brick_at(top);
-        let mut node = header_words(top) + 2 * ((b.z * tb.y + b.y) * tb.x + b.x) as usize;
+        let mut node = header_words(top) + NODE * ((b.z * tb.y + b.y) * tb.x + b.x) as usize;
         let mut found = Located::Coarse;
         let mut k = top;
         loop {
@@ -183,7 +197,7 @@ impl PageTree {
                 return (found, lo, hi);
             }
             let c = brick_at(k - 1).saturating_sub(b * 2).min(UVec3::ONE);
-            node = children + 2 * (c.x + 2 * c.y + 4 * c.z) as usize;
+            node = children + NODE * (c.x + 2 * c.y + 4 * c.z) as usize;
             k -= 1;
         }
     }
@@ -250,11 +264,11 @@ mod tests {
         // Drawn: brick (1, 1, 1) of level 0 (its parent is not) and brick (1, 1, 1) of
         // level 1; the rest falls to the coarse level.
         let resident = [BrickKey::new(0, UVec3::ONE), BrickKey::new(1, UVec3::ONE)];
-        let drawn: HashMap<BrickKey, Page> = resident.iter().enumerate().map(|(s, k)| (*k, Page::Slot(s as u32))).collect();
+        let drawn: HashMap<BrickKey, (Page, u64)> = resident.iter().enumerate().map(|(s, k)| (*k, (Page::Slot(s as u32), !0))).collect();
         let table_dims = [levels[0].grid.dims, levels[1].grid.dims];
         let tree = PageTree::build(&table_dims, layout, &drawn);
         // Header 4 + 8, the top grid's 8 nodes, one child block (level 0 under (0,0,0)).
-        assert_eq!(tree.words.len(), 12 + 16 + 16);
+        assert_eq!(tree.words.len(), 12 + 8 * NODE + 8 * NODE);
         let n = layout.stored();
         let blocks: Vec<Vec<f32>> = resident
             .iter()
@@ -330,10 +344,10 @@ mod tests {
         assert_eq!(tree.locate(Vec3::splat(10.0), origin).2, Vec3::splat(15.5));
         assert_eq!(tree.locate(Vec3::splat(17.0), origin).2, Vec3::splat(f32::MAX));
         // An empty brick is reported with its level; nothing drawn is the coarse level.
-        let empty = PageTree::build(&table_dims, layout, &HashMap::from([(BrickKey::new(1, UVec3::ZERO), Page::Empty(3))]));
+        let empty = PageTree::build(&table_dims, layout, &HashMap::from([(BrickKey::new(1, UVec3::ZERO), (Page::Empty(3), 0))]));
         assert_eq!(empty.locate(Vec3::splat(3.0), origin).0, Located::Empty { level: 1 });
         let none = PageTree::build(&table_dims, layout, &HashMap::new());
-        assert_eq!(none.words.len(), 12 + 16);
+        assert_eq!(none.words.len(), 12 + 8 * NODE);
         assert_eq!(none.locate(Vec3::splat(3.0), origin).0, Located::Coarse);
     }
 }

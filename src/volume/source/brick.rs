@@ -96,6 +96,47 @@ pub fn code_range(voxels: &Voxels) -> (u16, u16) {
     }
 }
 
+/// Edge of the sub-blocks whose ranges a brick keeps for finer empty-space skipping.
+pub const SUB_BLOCK: u32 = 8;
+
+impl BrickLayout {
+    /// Sub-blocks per axis of a brick's owned box (`B / 8`, at most 4: 64 in all).
+    pub fn sub_blocks(&self) -> u32 {
+        (self.size / SUB_BLOCK).clamp(1, 4)
+    }
+
+    /// The code range of each sub-block of a stored brick (x fastest), with the voxel
+    /// around it that trilinear samples inside it touch (when the apron holds it).
+    pub fn sub_ranges(&self, voxels: &Voxels) -> Vec<(u16, u16)> {
+        let (n, m, a) = (self.stored() as usize, self.sub_blocks() as usize, self.apron as usize);
+        let edge = self.size as usize / m;
+        let code = |x: usize, y: usize, z: usize| voxels.code((z * n + y) * n + x);
+        let span = |s: usize| {
+            let lo = (a + s * edge).saturating_sub(1);
+            lo..(a + (s + 1) * edge + 1).min(n)
+        };
+        let mut out = Vec::with_capacity(m * m * m);
+        for sz in 0..m {
+            for sy in 0..m {
+                for sx in 0..m {
+                    let (mut lo, mut hi) = (u16::MAX, 0u16);
+                    for z in span(sz) {
+                        for y in span(sy) {
+                            for x in span(sx) {
+                                let c = code(x, y, z);
+                                lo = lo.min(c);
+                                hi = hi.max(c);
+                            }
+                        }
+                    }
+                    out.push((lo, hi));
+                }
+            }
+        }
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use std::sync::Arc;
@@ -135,5 +176,21 @@ mod tests {
         assert!(layout.read(&source, 0, UVec3::new(3, 0, 0)).is_err());
         assert!(layout.read(&source, 5, UVec3::ZERO).is_err());
         assert_eq!(code_range(&Voxels::U16(vec![9, 3, 70])), (3, 70));
+    }
+
+    #[test]
+    fn sub_ranges_cover_each_sub_block_and_its_neighbouring_voxels() {
+        // 32³ owned + apron 1: a single hot voxel at stored (9, 1, 1) is in sub-block x 1
+        // (stored 9..17) and, as the voxel around sub-block 0 (stored 1..9), in its range too.
+        let layout = BrickLayout::new(32, 1);
+        let n = layout.stored() as usize;
+        let mut codes = vec![0u8; n * n * n];
+        codes[(n + 1) * n + 9] = 200;
+        let ranges = layout.sub_ranges(&Voxels::U8(codes));
+        assert_eq!(ranges.len(), 64);
+        assert_eq!(ranges[0], (0, 200));
+        assert_eq!(ranges[1], (0, 200));
+        assert_eq!(ranges[2], (0, 0));
+        assert_eq!(ranges[4], (0, 0), "sub-block (0, 1, 0) starts at stored y 9");
     }
 }

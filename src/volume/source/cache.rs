@@ -50,6 +50,8 @@ pub struct BrickData {
     pub voxels: Voxels,
     /// Smallest and largest code (apron included), for empty-space skipping.
     pub range: (u16, u16),
+    /// The same per 8³ sub-block ([`BrickLayout::sub_ranges`]).
+    pub sub_ranges: Vec<(u16, u16)>,
     /// Chunks of it that could not be read.
     pub faults: Vec<Fault>,
 }
@@ -186,7 +188,12 @@ impl BrickCache {
                 s.pending.remove(&k);
                 match result {
                     Ok(block) => {
-                        let data = BrickData { range: code_range(&block.voxels), voxels: block.voxels, faults: block.faults };
+                        let data = BrickData {
+                            range: code_range(&block.voxels),
+                            sub_ranges: layout.sub_ranges(&block.voxels),
+                            voxels: block.voxels,
+                            faults: block.faults,
+                        };
                         insert(&mut s, k, Arc::new(data), budget, pinned);
                         s.finished.push(k);
                     }
