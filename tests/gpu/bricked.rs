@@ -1,7 +1,7 @@
 //! GPU tests of bricked rendering (issue 23) on real data: the Colin27 T1 MRI converted
 //! to OME-Zarr, streamed brick by brick, must converge to the render of the same data
-//! fully in memory at the level the view chose, and a magnifier must show native voxels
-//! over a coarser context.
+//! fully in memory at the level the view chose (plain and context-preserving DVR), and a
+//! magnifier must show native voxels over a coarser context.
 //!
 //! Tolerance as the other GPU tests (mean below 1 level, 99 % within 6). What may differ:
 //! the bricked dataset's box is that of its coarse level (level 2: 46 voxels of 4 mm
@@ -81,6 +81,16 @@ pub fn bricked_ch2_converges_to_the_chosen_level_in_memory(gpu: &mut Gpu) {
     let (coarse_mean, _, _) = difference(&bricked, &level2);
     println!("    against the coarse level: mean {coarse_mean:.3}");
     assert!(coarse_mean > 1.5 * difference(&bricked, &level1).0 + 0.3, "the bricked image is the coarse level's (mean {coarse_mean:.3})");
+
+    // Context-preserving rendering (κt 3) on the bricked data: the same convergence.
+    let context = Appearance {
+        context: focal::context::ContextParams { kappa_t: 3.0, kappa_s: 0.5, ..Default::default() },
+        ..Appearance::new(Mode::Context, presets::builtin("mr_default").unwrap())
+    };
+    let bricked_context = show_bricked(gpu, &source, &context, &camera);
+    let level1_context = gpu.show(level(source.as_ref(), 1), context.clone(), &camera);
+    assert_matches("bricked_ch2_context", &bricked_context, &level1_context);
+    assert!(difference(&bricked_context, &bricked).0 > 1.0, "context-preserving rendering changed nothing");
 
     // A 4× magnifier over the middle: native voxels under it, level 1 around it.
     let lens = Lens::magnifier(Vec2::ZERO, 0.5, 0.2, 4.0);
