@@ -74,7 +74,11 @@ impl Plugin for FocalAppPlugin {
             )
             // The exploded views' physics: as many steps as the frame's time asks for.
             .add_systems(Update, (crate::explode::systems::run_steps, open_explode_panel).after(orbit::apply_orbit))
-            .add_systems(EguiPrimaryContextPass, (panels::ui, explode_panel::explode_panel, explode_overlay::explode_overlay).chain());
+            .add_systems(
+                EguiPrimaryContextPass,
+                (panels::ui, explode_panel::explode_panel, explode_overlay::explode_overlay, super::streaming_status::streaming_status)
+                    .chain(),
+            );
     }
 }
 

@@ -21,6 +21,7 @@ pub mod objects_panel;
 pub mod orbit;
 pub mod panels;
 pub mod state;
+pub mod streaming_status;
 pub mod tf_editor;
 pub mod viewport;
 pub mod window_tools;
