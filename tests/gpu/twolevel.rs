@@ -9,7 +9,12 @@ use focal::region::{Object, Segmentation};
 use focal::volume::phantom::head::label;
 
 fn segmented_head() -> (Arc<Volume>, Appearance) {
-    let h = phantom::head::generate(64).unwrap();
+    segmented_head_at(64)
+}
+
+/// The segmented head phantom at `n`³ voxels.
+pub fn segmented_head_at(n: u32) -> (Arc<Volume>, Appearance) {
+    let h = phantom::head::generate(n).unwrap();
     let ct = Arc::new(h.ct);
     let tf = |name: &str| presets::builtin(name).unwrap();
     let mut eyes = Object::new("eyes", vec![label::EYES as u32], Appearance::new(Mode::Dvr, tf("ct_soft_tissue")));
