@@ -132,21 +132,27 @@ fn bricked_texel(q0: vec3<f32>) -> vec3<f32> {
     return clamp((q0 + 0.5) / f32(1u << bc_level) - 0.5, vec3(0.0), bc_dims - 1.0) + bc_shift;
 }
 
+// The ray parameter where a ray at index q (t, moving qd voxels per unit t) leaves the
+// box [lo, hi] (reference: BrickGrid's exits; shared by the in-memory bricks).
+fn box_exit(lo: vec3<f32>, hi: vec3<f32>, q: vec3<f32>, qd: vec3<f32>, t: f32) -> f32 {
+    var exit = 3.4e38;
+    for (var a = 0; a < 3; a++) {
+        if qd[a] > 1e-12 {
+            exit = min(exit, (hi[a] - q[a]) / qd[a]);
+        } else if qd[a] < -1e-12 {
+            exit = min(exit, (lo[a] - q[a]) / qd[a]);
+        }
+    }
+    return t + max(exit, 0.0);
+}
+
 // After bricked_locate: the ray parameter where it leaves the answer's box (coarse
 // index q_C, voxels qd per unit t), at most `coarse_exit`.
 fn bricked_box_exit(r: Region, qc: vec3<f32>, qd: vec3<f32>, t: f32, coarse_exit: f32) -> f32 {
     let s = r.bricked_scale.x;
     let lo = (bc_lo + 0.5) / s - 0.5;
     let hi = (bc_hi + 0.5) / s - 0.5;
-    var exit = 3.4e38;
-    for (var a = 0; a < 3; a++) {
-        if qd[a] > 1e-12 {
-            exit = min(exit, (hi[a] - qc[a]) / qd[a]);
-        } else if qd[a] < -1e-12 {
-            exit = min(exit, (lo[a] - qc[a]) / qd[a]);
-        }
-    }
-    return min(t + max(exit, 0.0), coarse_exit);
+    return min(box_exit(lo, hi, qc, qd, t), coarse_exit);
 }
 
 // After bricked_locate of a brick: its sub-block holding q0 (level-k voxels of its lower
@@ -171,15 +177,7 @@ fn sub_block_exit(r: Region, q0: vec3<f32>, qc: vec3<f32>, qd: vec3<f32>, t: f32
     let f = f32(1u << bc_level) / r.bricked_scale.x;
     let lo = (lo_k + 0.5) * f - 0.5;
     let hi = (lo_k + SUB_BLOCK + 0.5) * f - 0.5;
-    var exit = 3.4e38;
-    for (var a = 0; a < 3; a++) {
-        if qd[a] > 1e-12 {
-            exit = min(exit, (hi[a] - qc[a]) / qd[a]);
-        } else if qd[a] < -1e-12 {
-            exit = min(exit, (lo[a] - qc[a]) / qd[a]);
-        }
-    }
-    return min(t + max(exit, 0.0), limit);
+    return min(box_exit(lo, hi, qc, qd, t), limit);
 }
 
 // After bricked_locate of a brick: the central-difference gradient at q0 from that brick

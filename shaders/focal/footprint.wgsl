@@ -8,21 +8,20 @@
 // coarse one.
 
 #import focal::types::Region
-#import focal::bindings::view
 #import focal::camera::Ray
-#import focal::lens::{lens_ray, camera_ray, Spread, spread_of, spread_extent}
+#import focal::lens::{lens_ray, camera_ray, pixel_steps, Spread, spread_of, spread_extent}
 #import focal::bricked::set_bricked_step
 
 var<private> ray_spread: Spread;
 
 fn prepare_ray_footprint(uv: vec2<f32>, ray: Ray) {
-    let px = vec2(1.0 / view.viewport.z, 0.0);
-    let py = vec2(0.0, 1.0 / view.viewport.w);
-    var rx = lens_ray(uv + px);
-    var ry = lens_ray(uv + py);
+    // (The lens's footprint where both neighbours have lens rays, else the camera's.)
+    let steps = pixel_steps();
+    var rx = lens_ray(uv + steps[0]);
+    var ry = lens_ray(uv + steps[1]);
     if dot(rx.dir, rx.dir) == 0.0 || dot(ry.dir, ry.dir) == 0.0 {
-        rx = camera_ray(uv + px);
-        ry = camera_ray(uv + py);
+        rx = camera_ray(uv + steps[0]);
+        ry = camera_ray(uv + steps[1]);
     }
     ray_spread = spread_of(ray, rx, ry);
 }

@@ -282,9 +282,15 @@ var<private> backward_deltas: array<vec3<f32>, 4>;
 
 // Prepares the pixel's footprint (no anti-aliasing where a right or lower neighbour
 // has no ray; forward differences only where a left or upper one has none).
+// One pixel right and one down, in uv.
+fn pixel_steps() -> array<vec2<f32>, 2> {
+    return array<vec2<f32>, 2>(vec2(1.0 / view.viewport.z, 0.0), vec2(0.0, 1.0 / view.viewport.w));
+}
+
 fn lens_footprint(uv: vec2<f32>, ray: Ray) {
-    let px = vec2(1.0 / view.viewport.z, 0.0);
-    let py = vec2(0.0, 1.0 / view.viewport.w);
+    let steps = pixel_steps();
+    let px = steps[0];
+    let py = steps[1];
     let rx = lens_ray(uv + px);
     let ry = lens_ray(uv + py);
     if dot(rx.dir, rx.dir) == 0.0 || dot(ry.dir, ry.dir) == 0.0 {

@@ -7,7 +7,7 @@
 
 #import focal::types::{Region, REGION_LABELS}
 #import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy, lut_atlas, brick_cache}
-#import focal::bricked::{is_bricked, level_zero, bricked_locate, bricked_texel, bricked_uvw, bricked_box_exit, bricked_step_factor, sub_block_visible, sub_block_exit, bricked_gradient, bc_kind, bc_code, BRICKED_TEXEL, BRICKED_EMPTY}
+#import focal::bricked::{is_bricked, level_zero, bricked_locate, bricked_texel, bricked_uvw, bricked_box_exit, box_exit, bricked_step_factor, sub_block_visible, sub_block_exit, bricked_gradient, bc_kind, bc_code, BRICKED_TEXEL, BRICKED_EMPTY}
 
 // Mip level the samples come from: set per sample under lenses with anti-aliasing
 // (focal::lens::update_lod), 0 otherwise (reference: PreparedRegion::sample).
@@ -206,26 +206,18 @@ fn brick_exit(r: Region, q: vec3<f32>, qd: vec3<f32>, t: f32) -> f32 {
     let size = f32(r.bricks.w);
     let lo = b * size - 0.5;
     let hi = (b + 1.0) * size - 0.5;
-    var exit = 3.4e38;
-    for (var a = 0; a < 3; a++) {
-        if qd[a] > 1e-12 {
-            exit = min(exit, (hi[a] - q[a]) / qd[a]);
-        } else if qd[a] < -1e-12 {
-            exit = min(exit, (lo[a] - q[a]) / qd[a]);
-        }
-    }
+    let exit = box_exit(lo, hi, q, qd, t);
 #ifdef HAS_BRICKED
     if is_bricked(r) {
         let q0 = level_zero(r, q);
         bricked_locate(r, q0);
-        let limit = bricked_box_exit(r, q, qd, t, t + max(exit, 0.0));
         if bc_kind == BRICKED_TEXEL {
             return sub_block_exit(r, q0, q, qd, t, bricked_box_exit(r, q, qd, t, 3.4e38));
         }
-        return limit;
+        return bricked_box_exit(r, q, qd, t, exit);
     }
 #endif
-    return t + max(exit, 0.0);
+    return exit;
 }
 
 // Code range of q's brick, normalised.

@@ -132,6 +132,20 @@ pub fn sixteen_bit_formats(adapter: &RenderAdapter) -> [TextureFormat; 2] {
     ]
 }
 
+/// A 3D texture the shader samples and uploads write to.
+pub fn sampled_3d(label: &str, size: UVec3, format: TextureFormat) -> TextureDescriptor<'_> {
+    TextureDescriptor {
+        label: Some(label),
+        size: Extent3d { width: size.x, height: size.y, depth_or_array_layers: size.z },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: TextureDimension::D3,
+        format,
+        usage: TextureUsages::TEXTURE_BINDING | TextureUsages::COPY_DST,
+        view_formats: &[],
+    }
+}
+
 fn texture_3d(
     device: &RenderDevice,
     queue: &RenderQueue,
@@ -140,21 +154,7 @@ fn texture_3d(
     format: TextureFormat,
     data: &[u8],
 ) -> (Texture, TextureView) {
-    let texture = device.create_texture_with_data(
-        queue,
-        &TextureDescriptor {
-            label: Some(label),
-            size: Extent3d { width: size.x, height: size.y, depth_or_array_layers: size.z },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: TextureDimension::D3,
-            format,
-            usage: TextureUsages::TEXTURE_BINDING | TextureUsages::COPY_DST,
-            view_formats: &[],
-        },
-        TextureDataOrder::LayerMajor,
-        data,
-    );
+    let texture = device.create_texture_with_data(queue, &sampled_3d(label, size, format), TextureDataOrder::LayerMajor, data);
     let view = texture.create_view(&TextureViewDescriptor::default());
     (texture, view)
 }

@@ -14,8 +14,12 @@ use super::select::{Magnified, Seen, ViewFrame, wanted};
 use crate::dataset::{Dataset, SceneRegions, VolumeView};
 use crate::lens::ViewLenses;
 use crate::lens::stack::Effect;
-use crate::region::RenderScene;
+use crate::region::appearance::CodeVisibility;
+use crate::region::{Appearance, RenderScene};
+use crate::volume::Volume;
 use crate::volume::source::cache::BrickKey;
+use std::collections::HashMap;
+use std::sync::Arc;
 
 /// The views of volume cameras this frame.
 pub fn view_frames(views: &Query<(&ViewLenses, &VolumeView)>) -> Vec<ViewFrame> {
@@ -49,6 +53,36 @@ fn seen_by(scene: &RenderScene, v: usize, coarse_index_to_dataset: Affine3A) -> 
         .collect()
 }
 
+/// The visibility tests of each bricked volume's looks, made again only when a look
+/// changes (each bakes the look's table).
+#[derive(Default)]
+pub struct VisibilityTests {
+    made: HashMap<usize, (Vec<Appearance>, Option<Tests>)>,
+}
+
+/// One test per look of a volume.
+type Tests = Arc<Vec<CodeVisibility>>;
+
+impl VisibilityTests {
+    /// The tests of `looks` on `volume`; `None` where a look may show any code.
+    fn of(&mut self, volume: &Arc<Volume>, looks: &[&Appearance]) -> Option<Tests> {
+        let key = Arc::as_ptr(volume) as usize;
+        let same = |made: &[Appearance]| made.len() == looks.len() && made.iter().zip(looks).all(|(a, b)| a == *b);
+        if let Some((_, tests)) = self.made.get(&key).filter(|(made, _)| same(made)) {
+            return tests.clone();
+        }
+        let tests: Option<Vec<CodeVisibility>> = looks.iter().map(|a| a.code_visibility(volume)).collect();
+        let tests = tests.map(Arc::new);
+        self.made.insert(key, (looks.iter().map(|a| (*a).clone()).collect(), tests.clone()));
+        tests
+    }
+
+    /// Forgets the volumes no longer in the scene.
+    fn keep(&mut self, scene: &RenderScene) {
+        self.made.retain(|k, _| scene.volumes.iter().any(|v| Arc::as_ptr(v) as usize == *k));
+    }
+}
+
 /// Asks for the bricks the views want and publishes what to draw ([`BrickedScene`]).
 pub fn stream_bricks(
     datasets: Query<(&Dataset, &BrickedDataset)>,
@@ -57,6 +91,7 @@ pub fn stream_bricks(
     budget: Res<StreamBudget>,
     status: Res<StreamStatus>,
     mut out: ResMut<BrickedScene>,
+    mut visibility: Local<VisibilityTests>,
 ) {
     let scene = &regions.scene;
     let frames = view_frames(&views);
@@ -81,8 +116,9 @@ pub fn stream_bricks(
                 a = a.parent();
             }
         }
-        let looks: Vec<_> = scene.regions.iter().filter(|r| r.volume == v).filter_map(|r| scene.appearances.get(r.appearance)).collect();
-        let tests: Option<Vec<_>> = looks.iter().map(|a| a.code_visibility(volume)).collect();
+        let looks: Vec<&Appearance> =
+            scene.regions.iter().filter(|r| r.volume == v).filter_map(|r| scene.appearances.get(r.appearance)).collect();
+        let tests = visibility.of(volume, &looks);
         let (mut drawn, mut empty) = (Vec::new(), Vec::new());
         for (_, k) in keys {
             let Some(data) = bricked.cache.get(k) else { continue };
@@ -118,6 +154,7 @@ pub fn stream_bricks(
             empty: std::sync::Arc::new(empty),
         });
     }
+    visibility.keep(scene);
     status.update(|c| {
         c.bricked = count;
         c.views = frames.len();

@@ -15,14 +15,14 @@ use std::sync::Arc;
 use bevy::prelude::*;
 use bevy::render::render_resource::{
     Buffer, BufferDescriptor, BufferUsages, Extent3d, Origin3d, TexelCopyBufferLayout, TexelCopyTextureInfo, Texture, TextureAspect,
-    TextureDescriptor, TextureDimension, TextureFormat, TextureUsages, TextureView, TextureViewDescriptor,
+    TextureFormat, TextureView, TextureViewDescriptor,
 };
 use bevy::render::renderer::{RenderAdapter, RenderDevice, RenderQueue};
 
 use super::page_table::{Page, PageTree};
 use super::slots::Slots;
 use crate::render::extract::ExtractedScene;
-use crate::render::upload::{GpuScene, sixteen_bit_formats, texel16};
+use crate::render::upload::{GpuScene, sampled_3d, sixteen_bit_formats, texel16};
 use crate::streaming::bricked::{BrickFrame, StreamStatus};
 use crate::volume::Voxels;
 use crate::volume::source::cache::BrickKey;
@@ -47,19 +47,6 @@ impl BrickAtlas {
     pub fn ready(&self) -> bool {
         self.view.is_some() && self.pages.is_some()
     }
-}
-
-fn create_texture(device: &RenderDevice, size: UVec3, format: TextureFormat) -> Texture {
-    device.create_texture(&TextureDescriptor {
-        label: Some("focal brick cache atlas"),
-        size: Extent3d { width: size.x, height: size.y, depth_or_array_layers: size.z },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: TextureDimension::D3,
-        format,
-        usage: TextureUsages::TEXTURE_BINDING | TextureUsages::COPY_DST,
-        view_formats: &[],
-    })
 }
 
 /// Texels of a brick's codes in `format` (8-bit codes as they are; else as the volume
@@ -98,7 +85,7 @@ pub fn upload_bricks(
         } else {
             Slots::new(1, 1, 1, 1)
         };
-        let texture = create_texture(&device, slots.texture_size(), format);
+        let texture = device.create_texture(&sampled_3d("focal brick cache atlas", slots.texture_size(), format));
         atlas.view = Some(texture.create_view(&TextureViewDescriptor::default()));
         atlas.texture = Some((texture, format));
         atlas.slots = Some(slots);
