@@ -2,10 +2,12 @@
 
 // Sampling bricked volumes through their page tables (render::bricked: the CPU
 // reference of the look-up is page_table::PageTree::locate). A region's coarse index
-// q_C becomes the level-0 index q = (q_C + ½)·2^C − ½; the tree of the drawn bricks is
-// descended from the top node holding q while nodes have children, keeping the last
-// page that is not missing. The answer holds over the box of the last node visited,
-// kept per ray (consecutive samples mostly stay in one brick).
+// q_C becomes the level-0 index q = (q_C + ½)·2^C − ½; its level-0 brick b₀ names the
+// directory word (b₀ >> G) and, where that is a block, the block's word for b₀: the
+// finest drawn brick holding q (resolved on the CPU), the level m over whose brick the
+// answer holds, and the brick's atlas slot. Two reads and no loop or cache: llvmpipe
+// runs every branch in every lane and one pass of every loop, so anything conditional
+// costs every sample.
 
 #import focal::types::Region
 #import focal::bindings::{pages, brick_cache, volume_sampler}
@@ -13,14 +15,14 @@
 const BRICKED_COARSE: u32 = 0u;
 const BRICKED_EMPTY: u32 = 1u;
 const BRICKED_TEXEL: u32 = 2u;
-// Page codes: 0 missing, EMPTY_PAGE | lowest code empty, slot + 2 in the atlas.
-const EMPTY_PAGE: u32 = 0x80000000u;
+const BRICKED_BLOCK: u32 = 3u;
 // Words before the page directory (render::bricked::atlas::PAGE_HEADER).
 const PAGE_HEADER: u32 = 8u;
+// Bits of a slot coordinate in a page word.
+const SLOT_BITS: u32 = 7u;
 
-// The cached answer: the region's directory entry (0: none), its level-0 box, what
-// it is, and for a brick the level, the level's dims and texel = clamp(q_k) + shift.
-var<private> bc_entry: u32 = 0u;
+// The answer of the last look-up: its level-0 box, what it is, and for a brick the
+// level, the level's dims and texel = clamp(q_k) + shift.
 var<private> bc_lo: vec3<f32>;
 var<private> bc_hi: vec3<f32>;
 var<private> bc_kind: u32 = 0u;
@@ -32,10 +34,8 @@ var<private> bc_code: f32 = 0.0;
 // level-k voxels (b·B).
 var<private> bc_mask: vec2<u32>;
 var<private> bc_origin: vec3<f32>;
-// 1 / the brick atlas's size (from the page buffer's header, read at a look-up).
+// 1 / the brick atlas's size (from the page buffer's header).
 var<private> bc_inv: vec3<f32>;
-// Words per node (render::bricked::page_table::NODE) and the sub-block edge.
-const NODE: u32 = 4u;
 const SUB_BLOCK: f32 = 8.0;
 // The ray's step at its level over the coarse step, 2^(L − C) (set per ray).
 var<private> bricked_step: f32 = 1.0;
@@ -56,70 +56,54 @@ fn level_zero(r: Region, qc: vec3<f32>) -> vec3<f32> {
     return (qc + 0.5) * r.bricked_scale.x - 0.5;
 }
 
-fn level_dims(tree: u32, k: u32) -> vec3<u32> {
-    let at = tree + 4u + 4u * k;
-    return vec3<u32>(pages[at], pages[at + 1u], pages[at + 2u]);
+// Voxel dims of level k of a pyramid whose levels halve exactly (⌈n/2ᵏ⌉).
+fn level_dims(d0: vec3<u32>, k: u32) -> vec3<u32> {
+    return (d0 + (1u << k) - 1u) >> vec3(k);
 }
 
-fn clamped_index(q0: vec3<f32>, k: u32, dims: vec3<u32>) -> vec3<f32> {
-    return clamp((q0 + 0.5) / f32(1u << k) - 0.5, vec3(0.0), vec3<f32>(dims) - 1.0);
+// Bricks of `size` voxels along each axis of `dims`.
+fn brick_count(dims: vec3<u32>, size: u32) -> vec3<u32> {
+    return vec3<u32>(ceil(vec3<f32>(dims) / f32(size)));
 }
 
-fn brick_at(q0: vec3<f32>, k: u32, dims: vec3<u32>, size: u32) -> vec3<u32> {
-    let b = vec3<u32>(max(floor((clamped_index(q0, k, dims) + 0.5) / f32(size)), vec3(0.0)));
-    return min(b, (dims + size - 1u) / size - 1u);
-}
-
-// Looks q0 (level-0 index) up in r's tree unless the cached answer holds.
+// Looks q0 (level-0 index) up in r's page table.
 fn bricked_locate(r: Region, q0: vec3<f32>) {
-    if bc_entry == r.bricked.x && all(q0 >= bc_lo) && all(q0 < bc_hi) {
-        return;
-    }
     let tree = pages[PAGE_HEADER + r.bricked.x - 1u];
-    let top = pages[tree];
-    let tb = vec3<u32>(pages[tree + 1u], pages[tree + 2u], pages[tree + 3u]);
     let size = r.bricked.y;
-    var k = top;
-    var dims = level_dims(tree, k);
-    var b = brick_at(q0, k, dims, size);
-    var node = tree + 4u + 4u * (top + 1u) + NODE * ((b.z * tb.y + b.y) * tb.x + b.x);
-    bc_kind = BRICKED_COARSE;
-    for (var i = 0u; i <= top; i++) {
-        let page = pages[node];
-        if page >= EMPTY_PAGE {
-            bc_kind = BRICKED_EMPTY;
-            bc_code = f32(page - EMPTY_PAGE);
-            bc_level = k;
-        } else if page >= 2u {
-            let s = page - 2u;
-            let g = vec3<u32>(pages[0], pages[1], pages[2]);
-            let origin = vec3<f32>(vec3<u32>(s % g.x, (s / g.x) % g.y, s / (g.x * g.y)) * pages[3]);
-            bc_kind = BRICKED_TEXEL;
-            bc_level = k;
-            bc_dims = vec3<f32>(dims);
-            bc_shift = origin + f32(r.bricked.z) + 0.5 - vec3<f32>(b * size);
-            bc_mask = vec2<u32>(pages[node + 2u], pages[node + 3u]);
-            bc_origin = vec3<f32>(b * size);
-            bc_inv = vec3(bitcast<f32>(pages[4]), bitcast<f32>(pages[5]), bitcast<f32>(pages[6]));
-        }
-        let children = pages[node + 1u];
-        if children == 0u || k == 0u {
-            break;
-        }
-        let below = level_dims(tree, k - 1u);
-        let bb = brick_at(q0, k - 1u, below, size);
-        let c = min(select(bb - 2u * b, vec3(0u), bb < 2u * b), vec3(1u));
-        node = tree + children + NODE * (c.x + 2u * c.y + 4u * c.z);
-        k -= 1u;
-        dims = below;
-        b = bb;
-    }
-    // The box of the last node, open past the level's first and last bricks.
-    let span = f32(size << k);
-    let n = (dims + size - 1u) / size;
-    bc_lo = select(vec3<f32>(b) * span - 0.5, vec3(-3.4e38), b == vec3(0u));
-    bc_hi = select(vec3<f32>(b + 1u) * span - 0.5, vec3(3.4e38), b + 1u >= n);
-    bc_entry = r.bricked.x;
+    let d0 = r.bricked_dims.xyz;
+    let g = r.bricked_dims.w;
+    let fsize = f32(size);
+    let b0 = min(vec3<u32>(max(floor((clamp(q0, vec3(0.0), vec3<f32>(d0) - 1.0) + 0.5) / fsize), vec3(0.0))), brick_count(d0, size) - 1u);
+    let bg = b0 >> vec3(g);
+    let ng = brick_count(level_dims(d0, g), size);
+    var word = pages[tree + (bg.z * ng.y + bg.y) * ng.x + bg.x];
+    let w = 1u << g;
+    let l = b0 - bg * w;
+    let in_block = pages[tree + (word & 0x3fffffffu) + (l.z * w + l.y) * w + l.x];
+    word = select(word, in_block, (word >> 30u) == BRICKED_BLOCK);
+    let kind = word >> 30u;
+    let k = (word >> 26u) & 15u;
+    let m = (word >> 22u) & 15u;
+    let bk = b0 >> vec3(k);
+    bc_kind = kind;
+    bc_level = k;
+    bc_code = f32(word & 0xffffu);
+    bc_dims = vec3<f32>(level_dims(d0, k));
+    let slot = vec3<u32>(word & 127u, (word >> SLOT_BITS) & 127u, (word >> (2u * SLOT_BITS)) & 127u);
+    let edge = pages[3];
+    bc_origin = vec3<f32>(bk * size);
+    bc_shift = vec3<f32>(slot * edge) + f32(r.bricked.z) + 0.5 - bc_origin;
+    let gx = pages[0];
+    let gy = pages[1];
+    let mask_at = pages[7] + 2u * (slot.x + gx * (slot.y + gy * slot.z));
+    bc_mask = vec2<u32>(pages[mask_at], pages[mask_at + 1u]);
+    bc_inv = vec3(bitcast<f32>(pages[4]), bitcast<f32>(pages[5]), bitcast<f32>(pages[6]));
+    // The box of level m's brick, open past the level's first and last bricks.
+    let bm = b0 >> vec3(m);
+    let span = f32(size << m);
+    let n = brick_count(level_dims(d0, m), size);
+    bc_lo = select(vec3<f32>(bm) * span - 0.5, vec3(-3.4e38), bm == vec3(0u));
+    bc_hi = select(vec3<f32>(bm + 1u) * span - 0.5, vec3(3.4e38), bm + 1u >= n);
 }
 
 // After bricked_locate of a brick: the atlas texture coordinate of q0.

@@ -48,6 +48,8 @@ struct Region {
     bricked: vec4<u32>,
     // 2^C, the level-0 voxel size in the volume's own millimetres.
     bricked_scale: vec4<f32>,
+    // Its level-0 voxel dims and page table directory level G.
+    bricked_dims: vec4<u32>,
 }
 
 struct Lens {

@@ -178,6 +178,9 @@ pub struct GpuRegion {
     /// `2^C` (coarse voxel index → level-0 index), the level-0 voxel size in the volume's
     /// own millimetres (the footprint's unit for a ray's level).
     pub bricked_scale: Vec4,
+    /// A bricked volume's level-0 voxel dims (xyz) and its page table's directory level
+    /// `G` (w; `render::bricked::page_table`).
+    pub bricked_dims: UVec4,
 }
 
 /// Regions the interval loop tests together (`REGION_CLUSTER` in

@@ -444,6 +444,7 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
         objects: UVec4::ZERO,
         bricked: UVec4::ZERO,
         bricked_scale: Vec4::ZERO,
+        bricked_dims: UVec4::ZERO,
     }
 }
 

@@ -128,6 +128,27 @@ pub fn two_level_on_bricked_data_matches_memory(gpu: &mut Gpu) {
     let bricked = show_bricked(gpu, &source, &look, &camera);
     let status = gpu.off.world_mut().resource::<StreamStatus>().counts();
     assert_eq!(status.finest_wanted, Some(0), "{status:?}");
+    // Hidden for a few frames and shown again, the volume keeps its bricks on the GPU
+    // (the atlas was given back as soon as no volume was bricked).
+    let held = status.on_gpu;
+    let visible = |gpu: &mut Gpu, on: bool| {
+        let world = gpu.off.world_mut();
+        let entities: Vec<Entity> = world.query_filtered::<Entity, With<Dataset>>().iter(world).collect();
+        for e in entities {
+            if let Some(mut d) = world.get_mut::<Dataset>(e) {
+                d.visible = on;
+            }
+        }
+    };
+    visible(gpu, false);
+    for _ in 0..3 {
+        gpu.off.update();
+    }
+    let hidden = gpu.off.world_mut().resource::<StreamStatus>().counts();
+    visible(gpu, true);
+    gpu.off.update();
+    let again = gpu.off.world_mut().resource::<StreamStatus>().counts();
+    assert!(held > 0 && hidden.on_gpu == held && again.on_gpu == held, "hidden: {hidden:?}, shown again: {again:?}, before {held}");
     let memory = gpu.show(ct.clone(), look.clone(), &camera);
     assert_matches("bricked_two_level", &bricked, &memory);
     let plain = gpu.show(ct, Appearance { segmentation: None, ..look }, &camera);

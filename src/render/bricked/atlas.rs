@@ -3,11 +3,12 @@
 //! One 3D texture of [`Slots`] (8-bit, or 16-bit where a bricked source has 16-bit
 //! codes, in the volume atlas's format so both normalise alike) sized by the GPU
 //! budget, and one storage buffer of `u32` words: the slot grid (4), `1 / texture size`
-//! as float bits (3) and a zero, the directory (each bricked volume's tree start), then
-//! the trees ([`PageTree`], child indices relative to their tree). The drawn bricks not
-//! yet in the atlas are uploaded coarse first, at most the budget's per frame; the rest
-//! are drawn from coarser levels until a later frame brings them (the status counts
-//! them, and the headless render waits for none to be left).
+//! as float bits (3) and the word where the sub-block masks start, the directory (each
+//! bricked volume's table start), the masks (two words per slot: its brick's 64
+//! sub-blocks), then the tables ([`PageTree`], block offsets relative to their table).
+//! The drawn bricks not yet in the atlas are uploaded coarse first, at most the budget's
+//! per frame; the rest are drawn from coarser levels until a later frame brings them
+//! (the status counts them, and the headless render waits for none to be left).
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -30,6 +31,10 @@ use crate::volume::source::cache::BrickKey;
 /// Words before the directory.
 pub const PAGE_HEADER: usize = 8;
 
+/// Frames without any bricked volume after which the atlas is given back (hiding a
+/// bricked volume for a moment, or switching between it and another, keeps its bricks).
+pub const RELEASE_AFTER_FRAMES: u32 = 600;
+
 /// A brick of some dataset (its coarse volume's address) in the atlas.
 type SlotKey = (usize, BrickKey);
 
@@ -41,6 +46,8 @@ pub struct BrickAtlas {
     slots: Option<Slots<SlotKey>>,
     pub pages: Option<Buffer>,
     capacity: u64,
+    /// Consecutive frames without a bricked volume.
+    idle_frames: u32,
 }
 
 impl BrickAtlas {
@@ -75,8 +82,11 @@ pub fn upload_bricks(
     let bpp = if format == TextureFormat::R8Unorm { 1 } else { 2 };
     let edge = frames.first().map_or(1, |(_, f)| f.layout.stored());
     let want_slots = !frames.is_empty();
+    atlas.idle_frames = if want_slots { 0 } else { atlas.idle_frames.saturating_add(1) };
+    let release = atlas.idle_frames >= RELEASE_AFTER_FRAMES;
     let stale = match (&atlas.texture, &atlas.slots) {
-        (Some((_, f)), Some(s)) => *f != format || s.edge != edge || !want_slots && s.len() > 1,
+        (Some((_, f)), Some(s)) if want_slots => *f != format || s.edge != edge,
+        (Some(_), Some(s)) => release && s.len() > 1,
         _ => true,
     };
     if stale {
@@ -95,9 +105,10 @@ pub fn upload_bricks(
     let size = slots.texture_size().as_vec3();
     let mut words: Vec<u32> = vec![slots.grid.x, slots.grid.y, slots.grid.z, slots.edge];
     words.extend((1.0 / size).to_array().map(f32::to_bits));
-    words.push(0);
-    let dir_at = words.len();
-    words.resize(dir_at + frames.len(), 0);
+    let dir_at = PAGE_HEADER;
+    let masks_at = dir_at + frames.len();
+    words.push(masks_at as u32);
+    words.resize(masks_at + 2 * slots.len(), 0);
     let (mut uploads, mut not_uploaded) = (0usize, 0usize);
     for (i, (v, frame)) in frames.iter().enumerate() {
         let id = extracted.scene.volumes.get(*v).map_or(0, |a| Arc::as_ptr(a) as usize);
@@ -131,7 +142,13 @@ pub fn upload_bricks(
             uploads += 1;
             drawn.insert(*k, (Page::Slot(s), *mask));
         }
-        let tree = PageTree::build(&frame.table_dims, frame.layout, &drawn);
+        for (page, mask) in drawn.values() {
+            if let Page::Slot(s) = page {
+                words[masks_at + 2 * *s as usize] = *mask as u32;
+                words[masks_at + 2 * *s as usize + 1] = (*mask >> 32) as u32;
+            }
+        }
+        let tree = PageTree::build(&frame.table_dims, frame.layout, &drawn, slots.grid);
         words[dir_at + i] = words.len() as u32;
         words.extend(tree.words);
     }

@@ -1,10 +1,12 @@
 //! Marks the packed regions of bricked volumes: every record whose volume is bricked
 //! (the region itself, an exploded view's parts, a segmentation's parts) gets its place
-//! in the page directory, brick layout and coarse level, and the ray caster's bound on
-//! loop iterations grows by `2^C` (a ray under a magnifier may step at level 0).
+//! in the page directory, brick layout, coarse level, level-0 dims and table directory
+//! level, and the ray caster's bound on loop iterations grows by `2^C` (a ray under a
+//! magnifier may step at level 0).
 
 use glam::{UVec4, Vec4};
 
+use super::page_table::directory_level;
 use crate::region::RenderScene;
 use crate::render::gpu_types::features;
 use crate::render::pack::PackedScene;
@@ -25,10 +27,13 @@ pub fn mark_bricked(packed: &mut PackedScene, scene: &RenderScene, frames: &[Opt
         let dims = volume.dims().as_vec3();
         let scale = (1u32 << frame.coarse) as f32;
         let entry = directory.len() as u32 + 1;
+        let Some(level0) = frame.table_dims.first().copied() else { continue };
+        let directory_level = directory_level(frame.table_dims.len() - 1);
         let mut any = false;
         for r in packed.regions.iter_mut().filter(|r| r.atlas_offset.truncate() == offset && r.dims.truncate() == dims) {
             r.bricked = UVec4::new(entry, frame.layout.size, frame.layout.apron, frame.coarse as u32);
             r.bricked_scale = Vec4::new(scale, volume.grid.min_spacing() / scale, 0.0, 0.0);
+            r.bricked_dims = level0.extend(directory_level as u32);
             any = true;
         }
         if any {

@@ -1,29 +1,33 @@
-//! The page table of a bricked dataset, as a tree of its drawn bricks.
+//! The page table of a bricked dataset: a directory over one level and blocks below
+//! it, each entry already resolved to the brick a sample there reads.
 //!
 //! Level `C` of the pyramid (the coarse level) is drawn from a whole volume in the
-//! volume atlas; levels `0 … C−1` are drawn from bricks in the brick atlas. The table
-//! holds one node for every brick of level `T = C − 1` (the top grid), and below any
-//! node with a drawn descendant a block of its eight children (bricks nest: brick `b` of
-//! level `k` holds bricks `2b + o` of level `k − 1`, since `q_k = (q + ½)/2ᵏ − ½`,
-//! [`crate::volume::pyramid::level_index`]). A node is four words: its [`Page`] (`slot +
-//! 2`, [`EMPTY_PAGE`] with the lowest code, `0` missing), the word index of its child
-//! block (`0` none), and for a brick in a slot the 64 bits of its 8³ sub-blocks that
-//! hold something visible (bit `x + 4y + 16z`; empty-space skipping at the granularity
-//! a volume in memory has).
+//! volume atlas; levels `0 … C−1` are drawn from bricks in the brick atlas. Bricks nest
+//! (brick `b` of level `k` holds bricks `2b + o` of level `k − 1`, since
+//! `q_k = (q + ½)/2ᵏ − ½`, [`crate::volume::pyramid::level_index`]), so the level-0
+//! brick `b₀` holding a sample names its ancestors: `b₀ >> k` at level `k`.
 //!
-//! A sample at continuous level-0 index `q` descends from the top node holding it while
-//! nodes have children, keeping the last page that is not missing: the finest drawn brick
-//! holding it, else the coarse volume. The result is the same for every `q` in the box of
-//! the last node visited, which the shader keeps as a cache (`shaders/focal/bricked.wgsl`,
-//! checked against [`PageTree::locate`], itself checked against sampling whole levels).
-//! Inside the brick the texel is `origin + A + (q_k − b·B) + ½` (A the apron).
+//! The table has one word per brick of the directory level `G = min(T, 3)` (`T = C − 1`
+//! the finest streamed level's top), and a block of `(2^G)³` words, one per level-0
+//! brick, under every directory brick with a drawn descendant finer than `G`. Each word
+//! is the answer for every sample in its brick: the finest drawn brick holding it (its
+//! kind, level `k` and atlas slot), else the coarse volume; with it the level `m ≥` the
+//! word's own over whose brick the answer holds (the box the ray caster may cross at
+//! once when the answer is empty). A look-up is two reads and no loop
+//! (`shaders/focal/bricked.wgsl`, checked against [`PageTree::locate`], itself checked
+//! against sampling whole levels): on llvmpipe every lane runs every branch and one pass
+//! of every loop, so the tree this replaced cost three times the volume's own fetches
+//! even when its per-ray cache held.
+//!
+//! Words: bits 30–31 the kind (missing, empty, a brick in a slot, or in the directory
+//! a block), 26–29 `k`, 22–25 `m`, then for a brick its slot's coordinates in the atlas
+//! grid (7 bits each), for an empty brick its lowest code (16 bits), for a block its
+//! word offset from the table's start (30 bits). Inside a brick the texel is
+//! `origin + A + (q_k − b·B) + ½` (A the apron).
 //!
 //! Which bricks are drawn is decided elsewhere (the wanted bricks of the view and their
-//! resident ancestors, [`crate::dataset::bricked`]): the table only records it, so the
-//! picture does not depend on what earlier views left resident.
-//!
-//! Words, from the tree's start: `T`, the top grid's brick counts (3), then per level
-//! `0 … T` its voxel dims (3) and a zero, then the nodes.
+//! resident ancestors, [`crate::streaming`]): the table only records it, so the picture
+//! does not depend on what earlier views left resident.
 
 use std::collections::{HashMap, HashSet};
 
@@ -44,42 +48,38 @@ pub enum Page {
     Slot(u32),
 }
 
-/// The page word of an empty brick: this bit and its lowest code.
-pub const EMPTY_PAGE: u32 = 1 << 31;
+/// Levels between the directory and level 0 at most: blocks of up to 8³ words.
+pub const BLOCK_LEVELS: usize = 3;
 
-impl Page {
-    pub fn code(self) -> u32 {
-        match self {
-            Page::Missing => 0,
-            Page::Empty(c) => EMPTY_PAGE | c as u32,
-            Page::Slot(s) => s + 2,
-        }
-    }
+/// Slots per axis of the atlas grid an entry can name.
+pub const MAX_SLOTS_PER_AXIS: u32 = (1 << SLOT_BITS) - 1;
 
-    pub fn from_code(code: u32) -> Page {
-        match code {
-            0 | 1 => Page::Missing,
-            c if c >= EMPTY_PAGE => Page::Empty((c - EMPTY_PAGE) as u16),
-            s => Page::Slot(s - 2),
-        }
-    }
+const SLOT_BITS: u32 = 7;
+const KIND_SHIFT: u32 = 30;
+const LEVEL_SHIFT: u32 = 26;
+const HOLDS_SHIFT: u32 = 22;
+const KIND_EMPTY: u32 = 1;
+const KIND_BRICK: u32 = 2;
+const KIND_BLOCK: u32 = 3;
+const OFFSET_MASK: u32 = (1 << KIND_SHIFT) - 1;
+
+/// The directory level of a table over streamed levels `0 … top`.
+pub fn directory_level(top: usize) -> usize {
+    top.min(BLOCK_LEVELS)
 }
 
-/// Words per node: page, child block, sub-block mask (two words).
-pub const NODE: usize = 4;
-
-fn write_node(words: &mut [u32], at: usize, node: Option<&(Page, u64)>) {
-    let (page, mask) = node.copied().unwrap_or((Page::Missing, 0));
-    words[at] = page.code();
-    if let Page::Slot(_) = page {
-        words[at + 2] = mask as u32;
-        words[at + 3] = (mask >> 32) as u32;
-    }
-}
-
-/// Words before the nodes: `T`, the top grid (3), and four per level `0 … T`.
-pub fn header_words(top: usize) -> usize {
-    4 + 4 * (top + 1)
+/// The word of `answer` (a drawn brick's page and level; `None`: the coarse volume),
+/// holding over the level-`holds` brick; `grid` the atlas's slots per axis.
+fn entry(answer: Option<(Page, usize)>, holds: usize, grid: UVec3) -> u32 {
+    let (kind, level, low) = match answer {
+        None | Some((Page::Missing, _)) => (0, 0, 0),
+        Some((Page::Empty(code), k)) => (KIND_EMPTY, k, code as u32),
+        Some((Page::Slot(s), k)) => {
+            let c = UVec3::new(s % grid.x, s / grid.x % grid.y, s / (grid.x * grid.y));
+            (KIND_BRICK, k, c.x | c.y << SLOT_BITS | c.z << (2 * SLOT_BITS))
+        }
+    };
+    kind << KIND_SHIFT | (level as u32) << LEVEL_SHIFT | (holds as u32) << HOLDS_SHIFT | low
 }
 
 /// The table of one dataset.
@@ -99,21 +99,103 @@ pub enum Located {
     Texel { level: usize, texel: Vec3 },
 }
 
+/// Building one table: the drawn bricks, those with a drawn descendant, the words.
+struct Builder<'a> {
+    layout: BrickLayout,
+    dims: &'a [UVec3],
+    drawn: &'a HashMap<BrickKey, (Page, u64)>,
+    inner: HashSet<BrickKey>,
+    grid: UVec3,
+    g: usize,
+    words: Vec<u32>,
+}
+
+impl Builder<'_> {
+    fn answer(&self, key: BrickKey, inherited: Option<(Page, usize)>) -> Option<(Page, usize)> {
+        match self.drawn.get(&key) {
+            Some((Page::Missing, _)) | None => inherited,
+            Some((page, _)) => Some((*page, key.level as usize)),
+        }
+    }
+
+    /// The children of `key` inside their level.
+    fn children(&self, key: BrickKey) -> impl Iterator<Item = BrickKey> + use<> {
+        let level = key.level as usize - 1;
+        let limit = self.layout.bricks(self.dims[level]);
+        let base = key.coords() * 2;
+        (0..8u32)
+            .map(move |o| base + UVec3::new(o & 1, o >> 1 & 1, o >> 2))
+            .filter(move |c| c.cmplt(limit).all())
+            .map(move |c| BrickKey::new(level, c))
+    }
+
+    /// Fills the words of directory bricks under `key` (level ≥ G).
+    fn directory(&mut self, key: BrickKey, inherited: Option<(Page, usize)>) {
+        let level = key.level as usize;
+        let answer = self.answer(key, inherited);
+        let ng = self.layout.bricks(self.dims[self.g]);
+        let index = |c: UVec3| ((c.z * ng.y + c.y) * ng.x + c.x) as usize;
+        if level == self.g {
+            let at = index(key.coords());
+            if level > 0 && self.inner.contains(&key) {
+                let block = self.words.len();
+                self.words[at] = KIND_BLOCK << KIND_SHIFT | block as u32;
+                let w = 1usize << level;
+                self.words.resize(block + w * w * w, 0);
+                self.block(block, key.coords() << level as u32, key, answer);
+            } else {
+                self.words[at] = entry(answer, level, self.grid);
+            }
+        } else if !self.inner.contains(&key) {
+            let word = entry(answer, level, self.grid);
+            let span = 1u32 << (level - self.g);
+            let lo = key.coords() * span;
+            let hi = (lo + span).min(ng);
+            for z in lo.z..hi.z {
+                for y in lo.y..hi.y {
+                    for x in lo.x..hi.x {
+                        self.words[index(UVec3::new(x, y, z))] = word;
+                    }
+                }
+            }
+        } else {
+            for c in self.children(key).collect::<Vec<_>>() {
+                self.directory(c, answer);
+            }
+        }
+    }
+
+    /// Fills the block at word `block` (level-0 bricks from `origin`) under `key`.
+    fn block(&mut self, block: usize, origin: UVec3, key: BrickKey, inherited: Option<(Page, usize)>) {
+        let level = key.level as usize;
+        let answer = self.answer(key, inherited);
+        if level > 0 && self.inner.contains(&key) {
+            for c in self.children(key).collect::<Vec<_>>() {
+                self.block(block, origin, c, answer);
+            }
+            return;
+        }
+        let w = 1u32 << self.g;
+        let word = entry(answer, level, self.grid);
+        let lo = (key.coords() << level as u32) - origin;
+        let hi = (lo + (1u32 << level)).min(UVec3::splat(w));
+        for z in lo.z..hi.z {
+            for y in lo.y..hi.y {
+                for x in lo.x..hi.x {
+                    self.words[block + ((z * w + y) * w + x) as usize] = word;
+                }
+            }
+        }
+    }
+}
+
 impl PageTree {
-    /// The tree over levels of `dims` (`0 … T`, the coarse level left out) drawing the
-    /// bricks of `drawn` (each with its sub-block mask).
-    pub fn build(dims: &[UVec3], layout: BrickLayout, drawn: &HashMap<BrickKey, (Page, u64)>) -> PageTree {
-        let top = dims.len().saturating_sub(1);
-        let mut words = Vec::new();
-        if dims.is_empty() {
-            return PageTree { layout, dims: Vec::new(), words };
-        }
-        let top_bricks = layout.bricks(dims[top]);
-        words.extend([top as u32, top_bricks.x, top_bricks.y, top_bricks.z]);
-        for d in dims {
-            words.extend([d.x, d.y, d.z, 0]);
-        }
-        // Every drawn brick and its ancestors up to the top: the nodes with children.
+    /// The table over levels of `dims` (`0 … T`, the coarse level left out) drawing the
+    /// bricks of `drawn` (each with its sub-block mask), the atlas having `grid` slots
+    /// per axis.
+    pub fn build(dims: &[UVec3], layout: BrickLayout, drawn: &HashMap<BrickKey, (Page, u64)>, grid: UVec3) -> PageTree {
+        let Some(top) = dims.len().checked_sub(1) else { return PageTree { layout, dims: Vec::new(), words: Vec::new() } };
+        // Every strict ancestor of a drawn brick: the bricks with drawn descendants.
         let mut inner: HashSet<BrickKey> = HashSet::new();
         for k in drawn.keys().filter(|k| (k.level as usize) <= top) {
             let mut a = *k;
@@ -124,82 +206,53 @@ impl PageTree {
                 }
             }
         }
-        let first = words.len();
-        let n = (top_bricks.x * top_bricks.y * top_bricks.z) as usize;
-        words.resize(first + NODE * n, 0);
-        // Breadth-first: (node word, key) whose children are still to place.
-        let mut queue = Vec::new();
-        for z in 0..top_bricks.z {
-            for y in 0..top_bricks.y {
-                for x in 0..top_bricks.x {
-                    let key = BrickKey::new(top, UVec3::new(x, y, z));
-                    let at = first + NODE * ((z * top_bricks.y + y) * top_bricks.x + x) as usize;
-                    write_node(&mut words, at, drawn.get(&key));
-                    if inner.contains(&key) {
-                        queue.push((at, key));
-                    }
+        let g = directory_level(top);
+        let ng = layout.bricks(dims[g]);
+        let mut b = Builder { layout, dims, drawn, inner, grid, g, words: vec![0; (ng.x * ng.y * ng.z) as usize] };
+        let tb = layout.bricks(dims[top]);
+        for z in 0..tb.z {
+            for y in 0..tb.y {
+                for x in 0..tb.x {
+                    b.directory(BrickKey::new(top, UVec3::new(x, y, z)), None);
                 }
             }
         }
-        while let Some((at, key)) = queue.pop() {
-            let block = words.len();
-            words[at + 1] = block as u32;
-            words.resize(block + 8 * NODE, 0);
-            let level = key.level as usize - 1;
-            let limit = layout.bricks(dims[level]);
-            for o in 0..8u32 {
-                let c = key.coords() * 2 + UVec3::new(o & 1, o >> 1 & 1, o >> 2);
-                if c.cmpge(limit).any() {
-                    continue;
-                }
-                let child = BrickKey::new(level, c);
-                let w = block + NODE * o as usize;
-                write_node(&mut words, w, drawn.get(&child));
-                if inner.contains(&child) {
-                    queue.push((w, child));
-                }
-            }
-        }
-        PageTree { layout, dims: dims.to_vec(), words }
+        PageTree { layout, dims: dims.to_vec(), words: b.words }
     }
 
-    /// Where continuous level-0 index `q` reads, `origin(slot)` giving a slot's texel
-    /// origin; and the level-0 box `[lo, hi)` over which the answer holds.
-    pub fn locate(&self, q: Vec3, origin: impl Fn(u32) -> UVec3) -> (Located, Vec3, Vec3) {
+    /// Where continuous level-0 index `q` reads (slots of `edge` texels), and the
+    /// level-0 box `[lo, hi)` over which the answer holds.
+    pub fn locate(&self, q: Vec3) -> (Located, Vec3, Vec3) {
         let Some(top) = self.dims.len().checked_sub(1) else { return (Located::Coarse, Vec3::MIN, Vec3::MAX) };
         let size = self.layout.size;
-        let w = |i: usize| self.words[i];
-        // The level-0 brick (clamped like the sample) whose ancestors the descent visits.
-        let brick_at = |k: usize| {
-            let d = self.dims[k].as_vec3();
-            let qk = ((q + 0.5) / (1u32 << k) as f32 - 0.5).clamp(Vec3::ZERO, d - 1.0);
-            ((qk + 0.5) / size as f32).floor().as_uvec3().min(self.layout.bricks(self.dims[k]) - 1)
-        };
-        let tb = UVec3::new(w(1), w(2), w(3));
-        let b = brick_at(top);
-        let mut node = header_words(top) + NODE * ((b.z * tb.y + b.y) * tb.x + b.x) as usize;
-        let mut found = Located::Coarse;
-        let mut k = top;
-        loop {
-            let b = brick_at(k);
-            match Page::from_code(w(node)) {
-                Page::Missing => {}
-                Page::Empty(_) => found = Located::Empty { level: k },
-                Page::Slot(s) => {
-                    let qk = ((q + 0.5) / (1u32 << k) as f32 - 0.5).clamp(Vec3::ZERO, self.dims[k].as_vec3() - 1.0);
-                    let inside = qk - (b * size).as_vec3();
-                    found = Located::Texel { level: k, texel: origin(s).as_vec3() + self.layout.apron as f32 + inside + 0.5 };
-                }
-            }
-            let children = w(node + 1) as usize;
-            if children == 0 || k == 0 {
-                let (lo, hi) = node_box(b, size << k, self.layout.bricks(self.dims[k]));
-                return (found, lo, hi);
-            }
-            let c = brick_at(k - 1).saturating_sub(b * 2).min(UVec3::ONE);
-            node = children + NODE * (c.x + 2 * c.y + 4 * c.z) as usize;
-            k -= 1;
+        let g = directory_level(top) as u32;
+        // The level-0 brick (clamped like the sample): its ancestors are b₀ >> k.
+        let d0 = self.dims[0];
+        let q0 = (q).clamp(Vec3::ZERO, d0.as_vec3() - 1.0);
+        let b0 = ((q0 + 0.5) / size as f32).floor().as_uvec3().min(self.layout.bricks(d0) - 1);
+        let ng = self.layout.bricks(self.dims[g as usize]);
+        let bg = b0 >> g;
+        let mut word = self.words[((bg.z * ng.y + bg.y) * ng.x + bg.x) as usize];
+        if word >> KIND_SHIFT == KIND_BLOCK {
+            let w = 1u32 << g;
+            let l = b0 - (bg << g);
+            word = self.words[(word & OFFSET_MASK) as usize + ((l.z * w + l.y) * w + l.x) as usize];
         }
+        let k = (word >> LEVEL_SHIFT & 15) as usize;
+        let m = word >> HOLDS_SHIFT & 15;
+        let found = match word >> KIND_SHIFT {
+            KIND_EMPTY => Located::Empty { level: k },
+            KIND_BRICK => {
+                let mask = (1u32 << SLOT_BITS) - 1;
+                let slot = UVec3::new(word & mask, word >> SLOT_BITS & mask, word >> (2 * SLOT_BITS) & mask);
+                let qk = ((q + 0.5) / (1u32 << k) as f32 - 0.5).clamp(Vec3::ZERO, self.dims[k].as_vec3() - 1.0);
+                let inside = qk - ((b0 >> k as u32) * size).as_vec3();
+                Located::Texel { level: k, texel: (slot * self.layout.stored()).as_vec3() + self.layout.apron as f32 + inside + 0.5 }
+            }
+            _ => Located::Coarse,
+        };
+        let (lo, hi) = node_box(b0 >> m, size << m, self.layout.bricks(self.dims[m as usize]));
+        (found, lo, hi)
     }
 }
 
@@ -223,10 +276,60 @@ mod tests {
     use crate::volume::source::{SourceLevel, VoxelSource, level_count, level_grid};
     use crate::volume::{Grid, Source, ValueMap, Volume, Voxels};
 
+    /// The finest drawn brick holding level-0 voxel index `q`, by brute force.
+    fn finest_drawn(drawn: &HashMap<BrickKey, (Page, u64)>, dims: &[UVec3], size: u32, q: Vec3) -> Option<(usize, Page)> {
+        (0..dims.len()).find_map(|k| {
+            let qk = ((q + 0.5) / (1u32 << k) as f32 - 0.5).clamp(Vec3::ZERO, dims[k].as_vec3() - 1.0);
+            let b = ((qk + 0.5) / size as f32).floor().as_uvec3().min((dims[k] + size - 1) / size - 1);
+            drawn.get(&BrickKey::new(k, b)).map(|(p, _)| (k, *p))
+        })
+    }
+
     #[test]
-    fn codes_round_trip() {
-        for p in [Page::Missing, Page::Empty(0), Page::Empty(65535), Page::Slot(0), Page::Slot(77)] {
-            assert_eq!(Page::from_code(p.code()), p);
+    fn every_entry_is_the_finest_drawn_brick_and_holds_over_its_box() {
+        // Five streamed levels (200³ … 13³ in 8³ bricks): the directory over level 3,
+        // blocks of 8³ level-0 bricks; drawn bricks scattered over every level.
+        let mut dims = vec![UVec3::new(200, 180, 150)];
+        for _ in 0..4 {
+            let d = *dims.last().expect("level");
+            dims.push((d + 1) / 2);
+        }
+        let layout = BrickLayout::new(8, 1);
+        let grid = UVec3::new(16, 16, 16);
+        let mut seed = 12345u64;
+        let mut next = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 33) as u32
+        };
+        let mut drawn = HashMap::new();
+        for i in 0..300u32 {
+            let k = (next() % 5) as usize;
+            let n = layout.bricks(dims[k]);
+            let b = UVec3::new(next() % n.x, next() % n.y, next() % n.z);
+            let page = if i % 3 == 0 { Page::Empty(i as u16) } else { Page::Slot(i) };
+            drawn.insert(BrickKey::new(k, b), (page, 0));
+        }
+        let tree = PageTree::build(&dims, layout, &drawn, grid);
+        let same = |a: Located, b: Option<(usize, Page)>| match (a, b) {
+            (Located::Coarse, None) => true,
+            (Located::Empty { level }, Some((k, Page::Empty(_)))) => level == k,
+            (Located::Texel { level, texel }, Some((k, Page::Slot(s)))) => {
+                let slot = UVec3::new(s % 16, s / 16 % 16, s / 256);
+                let lo = (slot * layout.stored()).as_vec3();
+                level == k && texel.cmpge(lo).all() && texel.cmplt(lo + layout.stored() as f32).all()
+            }
+            _ => false,
+        };
+        let d = dims[0].as_vec3();
+        for _ in 0..3000 {
+            let q = Vec3::new(next() as f32, next() as f32, next() as f32) / u32::MAX as f32 * 2.2 * d - 0.1 * d - 0.5;
+            let (found, lo, hi) = tree.locate(q);
+            assert!(same(found, finest_drawn(&drawn, &dims, 8, q)), "{q}: {found:?} against {:?}", finest_drawn(&drawn, &dims, 8, q));
+            assert!(q.cmpge(lo).all() && q.cmplt(hi).all(), "{q} outside its box {lo} … {hi}");
+            for t in [0.0f32, 0.3, 0.7, 0.999] {
+                let p = lo.max(Vec3::splat(-3.0)) + (hi.min(d + 3.0) - lo.max(Vec3::splat(-3.0))) * t;
+                assert!(same(found, finest_drawn(&drawn, &dims, 8, p)), "{p} in the box of {q}");
+            }
         }
     }
 
@@ -266,9 +369,11 @@ mod tests {
         let resident = [BrickKey::new(0, UVec3::ONE), BrickKey::new(1, UVec3::ONE)];
         let drawn: HashMap<BrickKey, (Page, u64)> = resident.iter().enumerate().map(|(s, k)| (*k, (Page::Slot(s as u32), !0))).collect();
         let table_dims = [levels[0].grid.dims, levels[1].grid.dims];
-        let tree = PageTree::build(&table_dims, layout, &drawn);
-        // Header 4 + 8, the top grid's 8 nodes, one child block (level 0 under (0,0,0)).
-        assert_eq!(tree.words.len(), 12 + 8 * NODE + 8 * NODE);
+        let grid = UVec3::new(2, 1, 1);
+        let tree = PageTree::build(&table_dims, layout, &drawn, grid);
+        // The directory over level 1 (2³ bricks) and one block of 2³ level-0 bricks, under
+        // level-1 brick (0, 0, 0).
+        assert_eq!(tree.words.len(), 8 + 8);
         let n = layout.stored();
         let blocks: Vec<Vec<f32>> = resident
             .iter()
@@ -287,7 +392,6 @@ mod tests {
                 }
             }
         }
-        let origin = |s: u32| UVec3::new(s * n, 0, 0);
         let whole = |k: usize, qk: Vec3| {
             let data = source.read_box(k, UVec3::ZERO, levels[k].grid.dims).expect("level").voxels;
             let d = levels[k].grid.dims;
@@ -316,7 +420,7 @@ mod tests {
             (Vec3::new(7.6, 8.1, 15.9), None),
         ];
         for (q, level) in cases {
-            let (found, lo, hi) = tree.locate(q, origin);
+            let (found, lo, hi) = tree.locate(q);
             assert!(q.cmpge(lo).all() && q.cmplt(hi).all(), "{q} outside its box {lo} … {hi}");
             match (found, level) {
                 (Located::Texel { level: k, texel }, Some(want)) => {
@@ -336,18 +440,18 @@ mod tests {
                     (Located::Texel { level: x, .. }, Located::Texel { level: y, .. }) => x == y,
                     (a, b) => a == b,
                 };
-                assert!(same(tree.locate(p, origin).0, found), "{p} in the box of {q}");
+                assert!(same(tree.locate(p).0, found), "{p} in the box of {q}");
             }
         }
         // The box of a level-0 brick inside the volume, and open past its edges.
-        assert_eq!(tree.locate(Vec3::splat(10.0), origin).1, Vec3::splat(7.5));
-        assert_eq!(tree.locate(Vec3::splat(10.0), origin).2, Vec3::splat(15.5));
-        assert_eq!(tree.locate(Vec3::splat(17.0), origin).2, Vec3::splat(f32::MAX));
+        assert_eq!(tree.locate(Vec3::splat(10.0)).1, Vec3::splat(7.5));
+        assert_eq!(tree.locate(Vec3::splat(10.0)).2, Vec3::splat(15.5));
+        assert_eq!(tree.locate(Vec3::splat(17.0)).2, Vec3::splat(f32::MAX));
         // An empty brick is reported with its level; nothing drawn is the coarse level.
-        let empty = PageTree::build(&table_dims, layout, &HashMap::from([(BrickKey::new(1, UVec3::ZERO), (Page::Empty(3), 0))]));
-        assert_eq!(empty.locate(Vec3::splat(3.0), origin).0, Located::Empty { level: 1 });
-        let none = PageTree::build(&table_dims, layout, &HashMap::new());
-        assert_eq!(none.words.len(), 12 + 8 * NODE);
-        assert_eq!(none.locate(Vec3::splat(3.0), origin).0, Located::Coarse);
+        let empty = PageTree::build(&table_dims, layout, &HashMap::from([(BrickKey::new(1, UVec3::ZERO), (Page::Empty(3), 0))]), grid);
+        assert_eq!(empty.locate(Vec3::splat(3.0)).0, Located::Empty { level: 1 });
+        let none = PageTree::build(&table_dims, layout, &HashMap::new(), grid);
+        assert_eq!(none.words.len(), 8);
+        assert_eq!(none.locate(Vec3::splat(3.0)).0, Located::Coarse);
     }
 }

@@ -23,9 +23,11 @@ pub struct Slots<K> {
 
 impl<K: Copy + Eq + Hash> Slots<K> {
     /// As many slots of `edge` texels as fit a texture of at most `max_texels` per axis
-    /// and `budget_bytes` in all (`texel_bytes` each); at least one.
+    /// and `budget_bytes` in all (`texel_bytes` each), at most
+    /// [`MAX_SLOTS_PER_AXIS`](super::page_table::MAX_SLOTS_PER_AXIS) per axis (the page
+    /// table names a slot in 7 bits an axis); at least one.
     pub fn new(edge: u32, max_texels: u32, budget_bytes: u64, texel_bytes: u32) -> Slots<K> {
-        let per_axis = (max_texels / edge.max(1)).max(1);
+        let per_axis = (max_texels / edge.max(1)).clamp(1, super::page_table::MAX_SLOTS_PER_AXIS);
         let slot_bytes = edge as u64 * edge as u64 * edge as u64 * texel_bytes as u64;
         let count = (budget_bytes / slot_bytes.max(1)).max(1);
         // The most slots within the budget, as a near-cube.
