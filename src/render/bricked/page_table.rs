@@ -228,7 +228,7 @@ impl PageTree {
         let g = directory_level(top) as u32;
         // The level-0 brick (clamped like the sample): its ancestors are b₀ >> k.
         let d0 = self.dims[0];
-        let q0 = (q).clamp(Vec3::ZERO, d0.as_vec3() - 1.0);
+        let q0 = q.clamp(Vec3::ZERO, d0.as_vec3() - 1.0);
         let b0 = ((q0 + 0.5) / size as f32).floor().as_uvec3().min(self.layout.bricks(d0) - 1);
         let ng = self.layout.bricks(self.dims[g as usize]);
         let bg = b0 >> g;
