@@ -53,7 +53,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 17] = [
+const DEFS: [&str; 18] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -71,6 +71,7 @@ const DEFS: [&str; 17] = [
     "DOI_CHANNEL",
     "COMPANION",
     "HAS_BRICKED",
+    "BRICKED_ONLY",
 ];
 
 #[test]
@@ -88,12 +89,14 @@ fn every_shader_variant_composes_and_validates() {
             && needs("HAS_SELECTION", "HAS_DVR", bits)
             && needs("DOI_CHANNEL", "HAS_SELECTION", bits)
             && needs("COMPANION", "DOI_CHANNEL", bits)
+            && needs("BRICKED_ONLY", "HAS_BRICKED", bits)
             && (bits & bit("HAS_HOLES") == 0 || bits & !interval_defs == 0)
     };
     // Bricked sampling sits inside the sampling functions under its own def, beside the
     // others' code but not inside it: with every pair of other defs and with all of
-    // them (every combination doubled the test's 3½ minutes).
-    let bricked = bit("HAS_BRICKED");
+    // them (every combination doubled the test's 3½ minutes), each with and without
+    // BRICKED_ONLY.
+    let bricked = bit("HAS_BRICKED") | bit("BRICKED_ONLY");
     let all_but_holes = ((1u32 << DEFS.len()) - 1) & !bricked & !bit("HAS_HOLES");
     let possible =
         |bits: u32| possible(bits) && (bits & bricked == 0 || (bits & !bricked).count_ones() <= 2 || bits & !bricked == all_but_holes);

@@ -69,10 +69,14 @@ fn trilinear_memory(r: Region, q: vec3<f32>) -> f32 {
 }
 
 // Sample of a bricked region: the finest drawn brick holding q, an empty brick's lowest
-// code (invisible under every look of the volume), else the coarse volume.
+// code (invisible under every look of the volume), else the coarse volume (never with
+// BRICKED_ONLY: the coarse level's bricks are in the atlas).
 fn bricked_sample(r: Region, q: vec3<f32>) -> f32 {
     let q0 = level_zero(r, q);
     bricked_locate(r, q0);
+#ifdef BRICKED_ONLY
+    return select(bc_code / r.dims.w, textureSampleLevel(brick_cache, volume_sampler, bricked_uvw(q0), 0.0).r, bc_kind == BRICKED_TEXEL);
+#else
     if bc_kind == BRICKED_TEXEL {
         return textureSampleLevel(brick_cache, volume_sampler, bricked_uvw(q0), 0.0).r;
     }
@@ -80,17 +84,24 @@ fn bricked_sample(r: Region, q: vec3<f32>) -> f32 {
         return bc_code / r.dims.w;
     }
     return trilinear_box(r.atlas_offset.xyz, r.dims.xyz, q);
+#endif
 }
 
 // Trilinear sample (normalised) at continuous voxel index q of the region's volume
-// (bricked volumes through their page table).
+// (bricked volumes through their page table). With BRICKED_ONLY every region is bricked
+// and the volume atlas's path is left out: llvmpipe runs both sides of a branch, which
+// made every sample of a bricked volume twice as dear as one in memory.
 fn trilinear(r: Region, q: vec3<f32>) -> f32 {
+#ifdef BRICKED_ONLY
+    return bricked_sample(r, q);
+#else
 #ifdef HAS_BRICKED
     if is_bricked(r) {
         return bricked_sample(r, q);
     }
 #endif
     return trilinear_memory(r, q);
+#endif
 }
 
 // The sample at q (x, as trilinear) and the degree of interest its volume carries in
@@ -116,16 +127,25 @@ fn nearest_code(r: Region, q: vec3<f32>) -> u32 {
     if is_bricked(r) {
         let q0 = level_zero(r, q);
         bricked_locate(r, q0);
+#ifdef BRICKED_ONLY
+        let texel = u32(round(textureLoad(brick_cache, vec3<i32>(floor(bricked_texel(q0))), 0).r * r.dims.w));
+        return select(u32(bc_code), texel, bc_kind == BRICKED_TEXEL);
+#else
         if bc_kind == BRICKED_TEXEL {
             return u32(round(textureLoad(brick_cache, vec3<i32>(floor(bricked_texel(q0))), 0).r * r.dims.w));
         }
         if bc_kind == BRICKED_EMPTY {
             return u32(bc_code);
         }
+#endif
     }
 #endif
+#ifdef BRICKED_ONLY
+    return 0u;
+#else
     let c = clamp(floor(q + 0.5), vec3(0.0), r.dims.xyz - 1.0);
     return u32(round(textureLoad(volume_atlas, vec3<i32>(r.atlas_offset.xyz + c), 0).r * r.dims.w));
+#endif
 }
 
 fn lut_texel(index: u32, atlas_width: u32) -> vec4<f32> {
@@ -161,17 +181,26 @@ fn index_gradient(r: Region, q: vec3<f32>, atlas_width: u32) -> vec3<f32> {
         h = bricked_step_factor();
         let q0 = level_zero(r, q);
         bricked_locate(r, q0);
+#ifdef BRICKED_ONLY
+        // (An empty brick's value is one code throughout.)
+        return select(vec3(0.0), bricked_gradient(r, q0, h), bc_kind == BRICKED_TEXEL);
+#else
         if bc_kind == BRICKED_TEXEL {
             return bricked_gradient(r, q0, h);
         }
+#endif
     }
 #endif
+#ifdef BRICKED_ONLY
+    return g;
+#else
     for (var a = 0; a < 3; a++) {
         var e = vec3(0.0);
         e[a] = h;
         g[a] = trilinear(r, q + e) - trilinear(r, q - e);
     }
     return 0.5 * g;
+#endif
 }
 
 // The brick holding q (reference: BrickGrid::brick_at).
@@ -186,22 +215,36 @@ fn brick_occupied(r: Region, q: vec3<f32>) -> bool {
     if is_bricked(r) {
         let q0 = level_zero(r, q);
         bricked_locate(r, q0);
+#ifdef BRICKED_ONLY
+        return bc_kind == BRICKED_TEXEL && sub_block_visible(q0);
+#else
         if bc_kind == BRICKED_EMPTY {
             return false;
         }
         if bc_kind == BRICKED_TEXEL {
             return sub_block_visible(q0);
         }
+#endif
     }
 #endif
+#ifdef BRICKED_ONLY
+    return false;
+#else
     let b = brick_of(r, q);
     let i = (b.z * r.bricks.y + b.y) * r.bricks.x + b.x;
     let word = occupancy[r.occupancy_offset + i / 32u];
     return ((word >> (i % 32u)) & 1u) != 0u;
+#endif
 }
 
 // Ray parameter where the ray leaves q's brick (voxel-space direction qd per unit t).
 fn brick_exit(r: Region, q: vec3<f32>, qd: vec3<f32>, t: f32) -> f32 {
+#ifdef BRICKED_ONLY
+    let q0 = level_zero(r, q);
+    bricked_locate(r, q0);
+    let exit = bricked_box_exit(r, q, qd, t, 3.4e38);
+    return select(exit, sub_block_exit(r, q0, q, qd, t, exit), bc_kind == BRICKED_TEXEL);
+#else
     let b = vec3<f32>(brick_of(r, q));
     let size = f32(r.bricks.w);
     let lo = b * size - 0.5;
@@ -218,16 +261,21 @@ fn brick_exit(r: Region, q: vec3<f32>, qd: vec3<f32>, t: f32) -> f32 {
     }
 #endif
     return exit;
+#endif
 }
 
 // Code range of q's brick, normalised.
 fn brick_range(r: Region, q: vec3<f32>) -> vec2<f32> {
-#ifdef HAS_BRICKED
     // (The coarse level's ranges do not bound its finer levels.)
+#ifdef BRICKED_ONLY
+    return vec2(0.0, 1.0);
+#else
+#ifdef HAS_BRICKED
     if is_bricked(r) {
         return vec2(0.0, 1.0);
     }
 #endif
     let b = brick_of(r, q) + r.brick_offset.xyz;
     return vec2<f32>(textureLoad(brick_atlas, vec3<i32>(b), 0).rg) / r.dims.w;
+#endif
 }

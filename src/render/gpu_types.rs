@@ -79,9 +79,13 @@ pub mod features {
     /// Some region samples a bricked volume through its page table
     /// (`render::bricked`).
     pub const BRICKED: u32 = 65536;
+    /// Every region samples a bricked volume whose coarse level is in the brick atlas
+    /// (`render::bricked`): every sample reads the atlas, and the paths to the volume
+    /// atlas, which llvmpipe ran beside the atlas's for every sample, are left out.
+    pub const BRICKED_ONLY: u32 = 131072;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 17] = [
+    pub const NAMES: [(u32, &str); 18] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -99,6 +103,7 @@ pub mod features {
         (DOI_CHANNEL, "DOI_CHANNEL"),
         (COMPANION, "COMPANION"),
         (BRICKED, "HAS_BRICKED"),
+        (BRICKED_ONLY, "BRICKED_ONLY"),
     ];
 }
 

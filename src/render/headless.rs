@@ -161,6 +161,14 @@ impl Offscreen {
         })
     }
 
+    /// The ray caster's shader features in the last frame (`render::gpu_types::features`).
+    pub fn shader_features(&self) -> Option<u32> {
+        let world = self.app.get_sub_app(RenderApp)?.world();
+        let scene = world.get_resource::<GpuScene>()?;
+        let atlas = world.get_resource::<crate::render::bricked::atlas::BrickAtlas>()?;
+        Some(crate::render::bricked::mark::pipeline_features(scene.features, atlas.coarse_in_atlas))
+    }
+
     /// Whether the last frame drew the volumes: the scene is uploaded and every view's
     /// pipeline is built.
     fn ready(&self) -> bool {

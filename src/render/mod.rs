@@ -77,7 +77,7 @@ impl Plugin for VolumeRenderPlugin {
                     upload::upload_scene.in_set(RenderSystems::PrepareResources),
                     bricked::atlas::upload_bricks.in_set(RenderSystems::PrepareResources).after(upload::upload_scene),
                     feature_pass::prepare_feature_buffers.in_set(RenderSystems::PrepareResources).after(upload::upload_scene),
-                    pipeline::prepare_pipelines.in_set(RenderSystems::Prepare),
+                    pipeline::prepare_pipelines.in_set(RenderSystems::Prepare).after(bricked::atlas::upload_bricks),
                     record_pipeline_state.in_set(RenderSystems::Cleanup),
                 ),
             )

@@ -98,15 +98,17 @@ pub fn prepare_pipelines(
     mut pipelines: ResMut<SpecializedRenderPipelines<RaycastPipeline>>,
     pipeline: Res<RaycastPipeline>,
     scene: Res<super::upload::GpuScene>,
+    atlas: Res<super::bricked::atlas::BrickAtlas>,
     views: Query<(Entity, &ViewTarget, &GpuSettings), With<ExtractedView>>,
 ) {
+    let features = super::bricked::mark::pipeline_features(scene.features, atlas.coarse_in_atlas);
     for (entity, target, settings) in &views {
         let lenses = match (settings.lens_count > 0, settings.flags & super::gpu_types::view_flags::LENS_ANTIALIAS != 0) {
             (false, _) => 0,
             (true, false) => features::LENSES,
             (true, true) => features::LENSES | features::LENS_ANTIALIAS,
         };
-        let key = RaycastKey { format: target.main_texture_format(), features: scene.features | lenses };
+        let key = RaycastKey { format: target.main_texture_format(), features: features | lenses };
         let id = pipelines.specialize(&cache, &pipeline, key);
         commands.entity(entity).insert(RaycastPipelineId(id));
     }

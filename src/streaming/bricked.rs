@@ -4,7 +4,10 @@
 //! finest level of at most [`COARSE_VOXELS`] voxels) is read whole into the dataset's
 //! [`Volume`] (what the CPU side — picking, statistics, the reference renderer — and
 //! the ray caster's last fallback use), and the levels `0 … C−1` stream as bricks of
-//! [`BRICK`] through a [`BrickCache`]. Levels must halve exactly (`⌈n/2⌉` voxels per
+//! [`BRICK`] through a [`BrickCache`]. The coarse level is also cut into bricks once, at
+//! open ([`BrickedDataset::coarse_bricks`]), drawn every frame: with them in the brick
+//! atlas every sample of the volume reads the atlas, and the ray caster needs no path to
+//! the volume atlas (`BRICKED_ONLY`, `render::bricked`). Levels must halve exactly (`⌈n/2⌉` voxels per
 //! axis, twice the spacing): bricks of neighbouring levels then nest, which the page
 //! table relies on (`render::bricked::page_table`); a pyramid that does not (ome-zarr-py
 //! often halves only y and x) is shown from one whole level instead, with a warning.
@@ -17,7 +20,8 @@ use crate::volume::Volume;
 use crate::volume::source::brick::BrickLayout;
 use crate::volume::source::cache::{BrickCache, BrickData, BrickKey};
 use crate::volume::source::level::read_level;
-use crate::volume::source::{SourceLevel, VoxelSource};
+use crate::volume::source::memory::MemorySource;
+use crate::volume::source::{SourceError, SourceLevel, VoxelSource};
 
 /// Bricks of 32³ voxels with an apron of two: trilinear filtering anywhere in the brick,
 /// and the gradient's neighbours one voxel away, read the brick alone.
@@ -79,6 +83,8 @@ pub struct BrickedDataset {
     pub levels: Vec<SourceLevel>,
     /// The level the dataset's volume holds.
     pub coarse: usize,
+    /// That level cut into bricks of [`BRICK`] (keys of level `coarse`).
+    pub coarse_bricks: Arc<Vec<(BrickKey, Arc<BrickData>)>>,
 }
 
 impl std::fmt::Debug for BrickedDataset {
@@ -124,17 +130,35 @@ impl BrickedDataset {
             warn!("{summary}");
         }
         let levels = info.levels.clone();
-        Ok(Ok((BrickedDataset { cache: Arc::new(BrickCache::new(source, BRICK, cpu_bytes)), levels, coarse }, volume)))
+        let coarse_bricks = Arc::new(bricks_of(&volume, coarse).map_err(|e| e.to_string())?);
+        let cache = Arc::new(BrickCache::new(source, BRICK, cpu_bytes));
+        Ok(Ok((BrickedDataset { cache, levels, coarse, coarse_bricks }, volume)))
     }
 
-    /// Voxel dims of the streamed levels `0 … C−1`.
+    /// Voxel dims of the levels `0 … C` the page table covers.
     pub fn table_dims(&self) -> Vec<UVec3> {
-        self.levels[..self.coarse].iter().map(|l| l.grid.dims).collect()
+        self.levels[..=self.coarse].iter().map(|l| l.grid.dims).collect()
     }
 
     pub fn bits(&self) -> u32 {
         self.cache.source().info().bits
     }
+}
+
+/// `volume` (level `level` of its pyramid) cut into bricks of [`BRICK`], apron included.
+fn bricks_of(volume: &Volume, level: usize) -> Result<Vec<(BrickKey, Arc<BrickData>)>, SourceError> {
+    let source = MemorySource::new(Arc::new(volume.clone()), u32::MAX);
+    let n = BRICK.bricks(volume.dims());
+    let mut out = Vec::with_capacity((n.x * n.y * n.z) as usize);
+    for z in 0..n.z {
+        for y in 0..n.y {
+            for x in 0..n.x {
+                let b = UVec3::new(x, y, z);
+                out.push((BrickKey::new(level, b), Arc::new(BrickData::new(BRICK, BRICK.read(&source, 0, b)?))));
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// Whether `b` is `a` halved: `⌈n/2⌉` voxels and twice the spacing on every axis.
@@ -147,7 +171,7 @@ fn halves(a: &SourceLevel, b: &SourceLevel) -> bool {
 /// The renderer's view of one bricked scene volume this frame.
 #[derive(Clone)]
 pub struct BrickFrame {
-    /// Voxel dims of the streamed levels (`0 … C−1`) and the brick layout.
+    /// Voxel dims of the levels the page table covers (`0 … C`) and the brick layout.
     pub table_dims: Vec<UVec3>,
     pub layout: BrickLayout,
     /// The coarse level's index `C`.
@@ -208,5 +232,31 @@ impl StreamStatus {
     pub fn converged(&self) -> bool {
         let c = self.counts();
         c.bricked == 0 || (c.views > 0 && c.pending == 0 && c.resident + c.failed as usize >= c.wanted && c.not_uploaded == 0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::volume::{Grid, Source, ValueMap, Voxels};
+
+    #[test]
+    fn the_coarse_level_is_cut_into_the_bricks_the_source_gives() {
+        let dims = UVec3::new(150, 90, 70);
+        let codes = (0..dims.x * dims.y * dims.z).map(|i| ((i as u64 * 7919) % 4093) as u16).collect();
+        let v =
+            Volume::new("noise", Grid::new(dims, Vec3::ONE), Voxels::U16(codes), ValueMap::IDENTITY, Source::default()).expect("volume");
+        let source: Arc<dyn VoxelSource> = Arc::new(MemorySource::new(Arc::new(v), 16));
+        let Ok(Ok((bricked, coarse))) = BrickedDataset::open(source.clone(), 1 << 20) else { panic!("streamed") };
+        // 75 × 45 × 35 voxels: the first level within 64³.
+        assert_eq!((bricked.coarse, coarse.dims()), (1, UVec3::new(75, 45, 35)));
+        assert_eq!(bricked.table_dims().len(), 2, "the page table covers levels 0 … C");
+        assert_eq!(bricked.coarse_bricks.len(), 3 * 2 * 2);
+        for (k, data) in bricked.coarse_bricks.iter() {
+            assert_eq!(k.level, 1);
+            let Ok(block) = BRICK.read(source.as_ref(), 1, k.coords()) else { panic!("brick {k:?}") };
+            assert!(data.voxels == block.voxels, "brick {k:?} differs from the source's");
+            assert_eq!(data.range, crate::volume::source::brick::code_range(&block.voxels));
+        }
     }
 }

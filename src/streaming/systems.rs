@@ -108,7 +108,7 @@ pub fn stream_bricks(
         let want = wanted(&bricked.levels, bricked.coarse, bricked.cache.layout(), &seen, &frames, cap.max(1));
         bricked.cache.request(&want);
         finest = want.iter().map(|k| k.level as usize).min().into_iter().chain(finest).min();
-        // The wanted bricks and their ancestors below the coarse level, coarse first.
+        // The wanted bricks and their ancestors below the coarse level, coarsest first.
         let mut keys: BTreeSet<(std::cmp::Reverse<u8>, BrickKey)> = BTreeSet::new();
         for k in &want {
             let mut a = *k;
@@ -120,8 +120,9 @@ pub fn stream_bricks(
             scene.regions.iter().filter(|r| r.volume == v).filter_map(|r| scene.appearances.get(r.appearance)).collect();
         let tests = visibility.of(volume, &looks);
         let (mut drawn, mut empty) = (Vec::new(), Vec::new());
-        for (_, k) in keys {
-            let Some(data) = bricked.cache.get(k) else { continue };
+        // The coarse level's bricks (always at hand), then the streamed ones present.
+        let coarse = bricked.coarse_bricks.iter().map(|(k, d)| (*k, d.clone()));
+        for (k, data) in coarse.chain(keys.into_iter().filter_map(|(_, k)| bricked.cache.get(k).map(|d| (k, d)))) {
             let shows = |(lo, hi): (u16, u16)| tests.as_ref().is_none_or(|t| t.is_empty() || t.iter().any(|f| f(lo, hi)));
             let mask = if shows(data.range) {
                 data.sub_ranges.iter().enumerate().filter(|(_, r)| shows(**r)).fold(0u64, |m, (i, _)| m | 1 << i)

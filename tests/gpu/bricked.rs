@@ -10,6 +10,7 @@
 
 use super::*;
 use focal::lens::{Lens, systems::replace_lenses};
+use focal::render::gpu_types::features::BRICKED_ONLY;
 use focal::streaming::bricked::{BrickedDataset, StreamStatus};
 use focal::volume::convert::ome_zarr::{WriteOptions, write};
 use focal::volume::readers::{ReadOptions, ome_zarr, read_volume};
@@ -35,7 +36,15 @@ fn level(source: &dyn VoxelSource, k: usize) -> Arc<Volume> {
     Arc::new(v)
 }
 
-fn show_bricked(gpu: &mut Gpu, source: &Arc<dyn VoxelSource>, appearance: &Appearance, camera: &FocalCamera) -> image::RgbaImage {
+/// The converged render of `source` bricked; `only`: whether every region is bricked
+/// (the ray caster then reads the brick atlas alone, `BRICKED_ONLY`).
+fn show_bricked(
+    gpu: &mut Gpu,
+    source: &Arc<dyn VoxelSource>,
+    appearance: &Appearance,
+    camera: &FocalCamera,
+    only: bool,
+) -> image::RgbaImage {
     gpu.clear();
     let (bricked, coarse) = BrickedDataset::open(source.clone(), 256 << 20).expect("readable").expect("streamed");
     let first_within = source.info().levels.iter().position(|l| l.grid.voxel_count() <= 1 << 18).expect("a small level");
@@ -45,6 +54,10 @@ fn show_bricked(gpu: &mut Gpu, source: &Arc<dyn VoxelSource>, appearance: &Appea
     let img = gpu.off.capture().unwrap_or_else(|e| panic!("{e}"));
     let status = gpu.off.world_mut().resource::<StreamStatus>().clone();
     assert!(status.converged(), "streaming did not converge: {:?}", status.counts());
+    // With the coarse level in the atlas, a scene of bricked regions alone samples the
+    // brick atlas alone.
+    let features = gpu.off.shader_features().unwrap_or(0);
+    assert_eq!(features & BRICKED_ONLY != 0, only, "BRICKED_ONLY (features {features:#x})");
     img
 }
 
@@ -71,7 +84,7 @@ pub fn bricked_ch2_converges_to_the_chosen_level_in_memory(gpu: &mut Gpu) {
     // level 1 (2 mm voxels) throughout; the coarse level 2 has 4 mm voxels.
     let eye = centre + Vec3::new(0.45, -0.85, 0.27).normalize() * 400.0;
     let camera = FocalCamera::look_at(eye, centre, Vec3::Z, FocalProjection::Orthographic { height: 200.0 });
-    let bricked = show_bricked(gpu, &source, &appearance, &camera);
+    let bricked = show_bricked(gpu, &source, &appearance, &camera, true);
     let status = gpu.off.world_mut().resource::<StreamStatus>().counts();
     assert_eq!(status.finest_wanted, Some(1), "{status:?}");
     assert!(status.wanted > 0 && status.on_gpu > 0, "{status:?}");
@@ -88,7 +101,7 @@ pub fn bricked_ch2_converges_to_the_chosen_level_in_memory(gpu: &mut Gpu) {
         context: focal::context::ContextParams { kappa_t: 3.0, kappa_s: 0.5, ..Default::default() },
         ..Appearance::new(Mode::Context, presets::builtin("mr_default").unwrap())
     };
-    let bricked_context = show_bricked(gpu, &source, &context, &camera);
+    let bricked_context = show_bricked(gpu, &source, &context, &camera, true);
     let level1_context = gpu.show(level(source.as_ref(), 1), context.clone(), &camera);
     assert_matches("bricked_ch2_context", &bricked_context, &level1_context);
     assert!(difference(&bricked_context, &bricked).0 > 1.0, "context-preserving rendering changed nothing");
@@ -96,7 +109,7 @@ pub fn bricked_ch2_converges_to_the_chosen_level_in_memory(gpu: &mut Gpu) {
     // A 4× magnifier over the middle: native voxels under it, level 1 around it.
     let lens = Lens::magnifier(Vec2::ZERO, 0.5, 0.2, 4.0);
     replace_lenses(gpu.off.world_mut(), std::slice::from_ref(&lens));
-    let magnified = show_bricked(gpu, &source, &appearance, &camera);
+    let magnified = show_bricked(gpu, &source, &appearance, &camera, true);
     let status = gpu.off.world_mut().resource::<StreamStatus>().counts();
     assert_eq!(status.finest_wanted, Some(0), "{status:?}");
     let native = gpu.show(level(source.as_ref(), 0), appearance.clone(), &camera);
@@ -125,7 +138,7 @@ pub fn two_level_on_bricked_data_matches_memory(gpu: &mut Gpu) {
     let extent = ct.grid.extent().max_element();
     let eye = centre + Vec3::new(0.6, -0.7, 0.4).normalize() * 2.0 * extent;
     let camera = FocalCamera::look_at(eye, centre, Vec3::Z, FocalProjection::Orthographic { height: 0.9 * extent });
-    let bricked = show_bricked(gpu, &source, &look, &camera);
+    let bricked = show_bricked(gpu, &source, &look, &camera, false);
     let status = gpu.off.world_mut().resource::<StreamStatus>().counts();
     assert_eq!(status.finest_wanted, Some(0), "{status:?}");
     // Hidden for a few frames and shown again, the volume keeps its bricks on the GPU

@@ -48,6 +48,9 @@ pub struct BrickAtlas {
     capacity: u64,
     /// Consecutive frames without a bricked volume.
     idle_frames: u32,
+    /// Whether every coarse-level brick of this frame's bricked volumes is in the atlas
+    /// or empty (each of their samples then reads the atlas).
+    pub coarse_in_atlas: bool,
 }
 
 impl BrickAtlas {
@@ -110,6 +113,7 @@ pub fn upload_bricks(
     words.push(masks_at as u32);
     words.resize(masks_at + 2 * slots.len(), 0);
     let (mut uploads, mut not_uploaded) = (0usize, 0usize);
+    let mut coarse_in_atlas = true;
     for (i, (v, frame)) in frames.iter().enumerate() {
         let id = extracted.scene.volumes.get(*v).map_or(0, |a| Arc::as_ptr(a) as usize);
         let mut drawn: HashMap<BrickKey, (Page, u64)> = frame.empty.iter().map(|(k, c)| (*k, (Page::Empty(*c), 0))).collect();
@@ -148,6 +152,7 @@ pub fn upload_bricks(
                 words[masks_at + 2 * *s as usize + 1] = (*mask >> 32) as u32;
             }
         }
+        coarse_in_atlas &= frame.drawn.iter().all(|(k, ..)| k.level as usize != frame.coarse || drawn.contains_key(k));
         let tree = PageTree::build(&frame.table_dims, frame.layout, &drawn, slots.grid);
         words[dir_at + i] = words.len() as u32;
         words.extend(tree.words);
@@ -157,6 +162,7 @@ pub fn upload_bricks(
         c.not_uploaded = not_uploaded;
     });
     atlas.slots = Some(slots);
+    atlas.coarse_in_atlas = coarse_in_atlas;
     let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
     if atlas.pages.is_none() || atlas.capacity < bytes.len() as u64 {
         let capacity = (bytes.len() as u64).next_power_of_two().max(256);

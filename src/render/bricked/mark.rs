@@ -2,7 +2,8 @@
 //! (the region itself, an exploded view's parts, a segmentation's parts) gets its place
 //! in the page directory, brick layout, coarse level, level-0 dims and table directory
 //! level, and the ray caster's bound on loop iterations grows by `2^C` (a ray under a
-//! magnifier may step at level 0).
+//! magnifier may step at level 0). Where every record is bricked the scene may take the
+//! `BRICKED_ONLY` shader (once the atlas holds every coarse brick: [`pipeline_features`]).
 
 use glam::{UVec4, Vec4};
 
@@ -44,6 +45,16 @@ pub fn mark_bricked(packed: &mut PackedScene, scene: &RenderScene, frames: &[Opt
     if !directory.is_empty() {
         packed.features |= features::BRICKED;
         packed.max_steps = packed.max_steps.saturating_mul(growth);
+        if packed.regions.iter().all(|r| r.bricked.x != 0) {
+            packed.features |= features::BRICKED_ONLY;
+        }
     }
     directory
+}
+
+/// The shader features of a scene of `features` this frame: `BRICKED_ONLY` holds only
+/// while the atlas has every coarse brick of every bricked volume (before, samples fall
+/// back to the coarse volume in the volume atlas).
+pub fn pipeline_features(features: u32, coarse_in_atlas: bool) -> u32 {
+    if coarse_in_atlas { features } else { features & !features::BRICKED_ONLY }
 }

@@ -16,7 +16,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use glam::UVec3;
 
 use super::brick::{BrickLayout, code_range};
-use super::{Fault, SourceError, VoxelSource};
+use super::{Block, Fault, SourceError, VoxelSource};
 use crate::volume::Voxels;
 
 /// A brick of one level.
@@ -57,6 +57,16 @@ pub struct BrickData {
 }
 
 impl BrickData {
+    /// A brick read with `layout`, with its code ranges.
+    pub fn new(layout: BrickLayout, block: Block) -> Self {
+        BrickData {
+            range: code_range(&block.voxels),
+            sub_ranges: layout.sub_ranges(&block.voxels),
+            voxels: block.voxels,
+            faults: block.faults,
+        }
+    }
+
     pub fn bytes(&self) -> u64 {
         self.voxels.byte_len() as u64
     }
@@ -188,13 +198,7 @@ impl BrickCache {
                 s.pending.remove(&k);
                 match result {
                     Ok(block) => {
-                        let data = BrickData {
-                            range: code_range(&block.voxels),
-                            sub_ranges: layout.sub_ranges(&block.voxels),
-                            voxels: block.voxels,
-                            faults: block.faults,
-                        };
-                        insert(&mut s, k, Arc::new(data), budget, pinned);
+                        insert(&mut s, k, Arc::new(BrickData::new(layout, block)), budget, pinned);
                         s.finished.push(k);
                     }
                     Err(e) => {
