@@ -181,6 +181,12 @@ fn converted_pyramids_pass_the_independent_check() {
     // A label atlas: levels keep label ids (nearest).
     let labels = WriteOptions { chunk: 64, downsample: Downsample::Nearest, ..Default::default() };
     convert_and_check(&data("labels/aal.nii.gz"), &dir.join("aal.ome.zarr"), &labels).expect("oracle");
+    // Float values (a float32 NIfTI nibabel wrote): a float32 pyramid, checked within the
+    // 16-bit codes' steps.
+    let fixtures = fixtures().expect("the oracle made its fixtures");
+    let line = convert_and_check(&fixtures.join("float32_source.nii.gz"), &dir.join("float.ome.zarr"), &WriteOptions { chunk: 8, ..Default::default() })
+        .expect("oracle");
+    assert!(line.contains("float32"), "{line}");
     // Writing over a pyramid needs the overwrite flag; over anything else it is refused.
     let volume = read_volume(&data("ct/fuel.nii.gz"), &ReadOptions::default()).expect("reads");
     let again = write(&volume, &dir.join("fuel.ome.zarr"), &WriteOptions::default(), &|_, _| {}).expect_err("exists");
@@ -190,6 +196,17 @@ fn converted_pyramids_pass_the_independent_check() {
     std::fs::write(other.join("notes.txt"), "keep me").expect("file");
     let err = write(&volume, &other, &WriteOptions { overwrite: true, ..Default::default() }, &|_, _| {}).expect_err("refused");
     assert!(err.contains("not a Zarr pyramid") && other.join("notes.txt").exists(), "{err}");
+    // A conversion stopped half way (here by a panic in its progress callback) leaves a
+    // Zarr group without multiscales: no reader takes it for a pyramid, and --force
+    // replaces it.
+    let stopped = dir.join("stopped.ome.zarr");
+    let stop = |done: u64, _| assert!(done < 4096, "stopped by the test");
+    let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| write(&volume, &stopped, &WriteOptions::default(), &stop)));
+    assert!(stopped.join("zarr.json").is_file(), "the stopped conversion left no group");
+    let open = focal::volume::readers::ome_zarr::open(&stopped).err().expect("a half-written pyramid is refused");
+    assert!(open.to_string().contains("multiscales"), "{open}");
+    write(&volume, &stopped, &WriteOptions { overwrite: true, ..Default::default() }, &|_, _| {}).expect("--force replaces it");
+    focal::volume::readers::ome_zarr::open(&stopped).expect("the pyramid opens");
 }
 
 #[test]
@@ -245,6 +262,10 @@ fn bad_chunks_and_metadata_are_named_and_the_rest_is_drawn() {
     let bad: Vec<_> = b.faults.iter().filter(|f| f.kind == FaultKind::Unreadable).collect();
     assert_eq!(bad.len(), 1, "{:?}", b.faults);
     assert_eq!(bad[0].chunk, "0/1/1/1");
+    // A box the level does not hold is refused, naming the folder (the image's own
+    // NGFF name, "fixture", tells a user nothing).
+    let err = s.read_box(0, UVec3::ZERO, UVec3::splat(1000)).expect_err("outside the level");
+    assert!(err.to_string().contains(&p.display().to_string()), "{err}");
     // Outside the bad chunk, the values are right.
     assert_eq!(b.voxels.code(0), 0);
     let at = |x: u32, y: u32, z: u32| b.voxels.code(((z * 24 + y) * 28 + x) as usize) as u32;
@@ -256,6 +277,18 @@ fn bad_chunks_and_metadata_are_named_and_the_rest_is_drawn() {
     let b = s.read_box(0, UVec3::ZERO, UVec3::splat(4)).expect("box");
     assert_eq!(b.faults.len(), 1);
     assert_eq!((b.faults[0].kind, b.faults[0].chunk.as_str()), (FaultKind::Absent, "0/0/0/0"));
+    // With a fill value of its own (700), the corrupt chunk and the absent one read as
+    // that, not as 0.
+    let zarray = p.join("0/.zarray");
+    let meta: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&zarray).expect("metadata")).expect("json");
+    let mut meta = meta;
+    meta["fill_value"] = serde_json::json!(700);
+    std::fs::write(&zarray, meta.to_string()).expect("edit");
+    let filled = ome_zarr::open(&p).expect("opens");
+    let b = filled.read_box(0, UVec3::ZERO, UVec3::new(28, 24, 20)).expect("box");
+    let at = |x: u32, y: u32, z: u32| b.voxels.code(((z * 24 + y) * 28 + x) as usize) as u32;
+    assert_eq!((at(9, 9, 9), at(1, 1, 1)), (700, 700), "the corrupt and the absent chunk read as the fill value");
+    assert_eq!(at(27, 23, 19), 1077);
     // The volume read reports both as notes.
     let v = ome_zarr::read(&p, &ReadOptions::default()).expect("reads");
     let notes: Vec<&String> = v.source.details.iter().filter(|(k, _)| k == "note").map(|(_, n)| n).collect();

@@ -37,11 +37,27 @@ var<private> bc_origin: vec3<f32>;
 // 1 / the brick atlas's size (from the page buffer's header).
 var<private> bc_inv: vec3<f32>;
 const SUB_BLOCK: f32 = 8.0;
-// The ray's step at its level over the coarse step, 2^(L − C) (set per ray).
+// Words before a volume's page tree: its levels' gradient normalisation
+// (render::bricked::atlas::GRADIENT_NORMS).
+const GRADIENT_NORMS: u32 = 16u;
+// The ray's step at its level over the coarse step, 2^(L − C), and the largest gradient
+// of level L (set per ray).
 var<private> bricked_step: f32 = 1.0;
+var<private> bricked_gradient_norm: f32 = 1.0;
 
-fn set_bricked_step(f: f32) {
+// Sets the ray's level l (of 0 … C) in bricked region r; returns its step factor.
+fn set_bricked_level(r: Region, l: f32) -> f32 {
+    let f = exp2(l - f32(r.bricked.w));
     bricked_step = f;
+    let tree = pages[PAGE_HEADER + r.bricked.x - 1u];
+    bricked_gradient_norm = bitcast<f32>(pages[tree - GRADIENT_NORMS + u32(l)]);
+    return f;
+}
+
+// The largest gradient magnitude of the ray's level (the normalisation of a bricked
+// region's gradients, BrickedDataset::gradient_max).
+fn bricked_gradient_max() -> f32 {
+    return bricked_gradient_norm;
 }
 
 fn bricked_step_factor() -> f32 {

@@ -10,7 +10,7 @@
 #import focal::types::Region
 #import focal::camera::Ray
 #import focal::lens::{lens_ray, camera_ray, pixel_steps, Spread, spread_of, spread_extent}
-#import focal::bricked::set_bricked_step
+#import focal::bricked::set_bricked_level
 
 var<private> ray_spread: Spread;
 
@@ -32,7 +32,5 @@ fn bricked_step_at(r: Region, dir: vec3<f32>, t: f32) -> f32 {
     let native = spread_extent(ray_spread, depth) * length((r.to_native * vec4(dir, 0.0)).xyz);
     let c = f32(r.bricked.w);
     let l = clamp(floor(log2(max(native, 1e-30) / r.bricked_scale.y)), 0.0, c);
-    let f = exp2(l - c);
-    set_bricked_step(f);
-    return f;
+    return set_bricked_level(r, l);
 }

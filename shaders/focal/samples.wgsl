@@ -9,7 +9,7 @@
 #import focal::bindings::{settings, scene}
 #import focal::camera::Ray
 #import focal::regions::to_voxel
-#import focal::sampling::{trilinear, trilinear_with_doi, nearest_code, index_gradient}
+#import focal::sampling::{trilinear, trilinear_with_doi, nearest_code, index_gradient, gradient_norm}
 #import focal::transfer::{classify, classify_label, classify_lambda, correct_opacity, filtered_table}
 #import focal::shading::{shade, shade_with, blinn_phong}
 #import focal::context::{context_opacity, eye_distance}
@@ -106,7 +106,7 @@ fn dvr_classified(r: Region, q: vec3<f32>, v: f32, rgba: vec4<f32>, weight: f32,
     if needs_gradient {
         let gi = index_gradient(r, q, scene.lut_atlas_width);
         let g = (r.normal_matrix * vec4(gi, 0.0)).xyz;
-        let magnitude = min(length(gi) / r.gradient_max, 1.0);
+        let magnitude = min(length(gi) / gradient_norm(r), 1.0);
 #ifdef HAS_GRADIENT_MODULATION
         if r.mode == MODE_GRADIENT_DVR && !labels {
             alpha *= magnitude;

@@ -7,7 +7,7 @@
 
 #import focal::types::{Region, REGION_LABELS}
 #import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy, lut_atlas, brick_cache}
-#import focal::bricked::{is_bricked, level_zero, bricked_locate, bricked_texel, bricked_uvw, bricked_box_exit, box_exit, bricked_step_factor, sub_block_visible, sub_block_exit, bricked_gradient, bc_kind, bc_code, BRICKED_TEXEL, BRICKED_EMPTY}
+#import focal::bricked::{is_bricked, level_zero, bricked_locate, bricked_texel, bricked_uvw, bricked_box_exit, box_exit, bricked_step_factor, sub_block_visible, sub_block_exit, bricked_gradient, bricked_gradient_max, bc_kind, bc_code, BRICKED_TEXEL, BRICKED_EMPTY}
 
 // Mip level the samples come from: set per sample under lenses with anti-aliasing
 // (focal::lens::update_lod), 0 otherwise (reference: PreparedRegion::sample).
@@ -200,6 +200,20 @@ fn index_gradient(r: Region, q: vec3<f32>, atlas_width: u32) -> vec3<f32> {
         g[a] = trilinear(r, q + e) - trilinear(r, q - e);
     }
     return 0.5 * g;
+#endif
+}
+
+// What r's gradient magnitudes are divided by: the volume's largest, or for a bricked
+// region the largest of the level its ray steps at (set with the ray's level).
+fn gradient_norm(r: Region) -> f32 {
+#ifdef BRICKED_ONLY
+    return bricked_gradient_max();
+#else
+#ifdef HAS_BRICKED
+    return select(r.gradient_max, bricked_gradient_max(), is_bricked(r));
+#else
+    return r.gradient_max;
+#endif
 #endif
 }
 

@@ -85,6 +85,12 @@ pub struct BrickedDataset {
     pub coarse: usize,
     /// That level cut into bricks of [`BRICK`] (keys of level `coarse`).
     pub coarse_bricks: Arc<Vec<(BrickKey, Arc<BrickData>)>>,
+    /// The largest gradient magnitude seen at each level `0 … C` (normalised units per
+    /// voxel of the level): the largest over the bricks of that level drawn so far
+    /// (it only grows), the whole coarse level's at `C`. A volume in memory normalises
+    /// by the largest over the whole volume, which a pyramid too large to read cannot
+    /// know; once the bricks of a view are in, the view's is at hand.
+    pub gradient_max: Vec<f32>,
 }
 
 impl std::fmt::Debug for BrickedDataset {
@@ -103,7 +109,7 @@ impl BrickedDataset {
         }
         if let Some(k) = (1..info.levels.len()).find(|&k| !halves(&info.levels[k - 1], &info.levels[k])) {
             return Ok(Err(format!(
-                "{}: level {k} is not level {} halved on every axis; shown from one whole level, not streamed",
+                "{}: level {k} is not level {} halved on every axis (⌈n/2⌉ voxels of twice the spacing, centred on blocks of 2×2×2); shown from one whole level, not streamed",
                 info.name,
                 k - 1
             )));
@@ -127,12 +133,14 @@ impl BrickedDataset {
             volume.stats.max = volume.stats.max.max(hi);
         }
         if let Some(summary) = crate::volume::source::level::summarize(&faults) {
-            warn!("{summary}");
+            warn!("{}: {summary}", info.location());
         }
         let levels = info.levels.clone();
         let coarse_bricks = Arc::new(bricks_of(&volume, coarse).map_err(|e| e.to_string())?);
         let cache = Arc::new(BrickCache::new(source, BRICK, cpu_bytes));
-        Ok(Ok((BrickedDataset { cache, levels, coarse, coarse_bricks }, volume)))
+        let mut gradient_max = vec![0.0; coarse + 1];
+        gradient_max[coarse] = coarse_bricks.iter().map(|(_, b)| b.gradient_max).fold(0.0, f32::max);
+        Ok(Ok((BrickedDataset { cache, levels, coarse, coarse_bricks, gradient_max }, volume)))
     }
 
     /// Voxel dims of the levels `0 … C` the page table covers.
@@ -142,6 +150,30 @@ impl BrickedDataset {
 
     pub fn bits(&self) -> u32 {
         self.cache.source().info().bits
+    }
+
+    /// Takes the gradients of `bricks` into [`Self::gradient_max`]; whether it grew.
+    pub fn see_gradients<'a>(&mut self, bricks: impl IntoIterator<Item = (BrickKey, &'a BrickData)>) -> bool {
+        let mut grew = false;
+        for (k, b) in bricks {
+            if let Some(m) = self.gradient_max.get_mut(k.level as usize).filter(|m| **m < b.gradient_max) {
+                *m = b.gradient_max;
+                grew = true;
+            }
+        }
+        grew
+    }
+
+    /// The normalisation of each level's gradients `0 … C`: its largest seen, or where
+    /// none was yet (no brick of it drawn, or all flat) the next coarser level's.
+    pub fn gradient_norms(&self) -> Vec<f32> {
+        let mut out = self.gradient_max.clone();
+        for k in (0..out.len().saturating_sub(1)).rev() {
+            if out[k] <= 0.0 {
+                out[k] = out[k + 1];
+            }
+        }
+        out.iter().map(|m| m.max(1e-6)).collect()
     }
 }
 
@@ -161,11 +193,17 @@ fn bricks_of(volume: &Volume, level: usize) -> Result<Vec<(BrickKey, Arc<BrickDa
     Ok(out)
 }
 
-/// Whether `b` is `a` halved: `⌈n/2⌉` voxels and twice the spacing on every axis.
+/// Whether `b` is `a` halved: `⌈n/2⌉` voxels of twice the spacing on every axis, each
+/// centred on its block of 2×2×2 voxels of `a` (the first at `a`'s origin plus half a
+/// voxel; within a twentieth of a voxel). A pyramid sampled at every other voxel (its
+/// levels' origins all alike) does not nest so: streamed, its finer levels would lie
+/// up to half a coarse voxel off.
 fn halves(a: &SourceLevel, b: &SourceLevel) -> bool {
     let dims = (a.grid.dims + 1) / 2 == b.grid.dims;
     let spacing = (b.grid.spacing - 2.0 * a.grid.spacing).abs().cmple(a.grid.spacing * 1e-3).all();
-    dims && spacing
+    let centre = a.grid.index_to_world().transform_point3(Vec3::splat(0.5));
+    let offset = a.grid.world_to_index().transform_point3(b.grid.origin) - a.grid.world_to_index().transform_point3(centre);
+    dims && spacing && offset.abs().cmple(Vec3::splat(0.05)).all()
 }
 
 /// The renderer's view of one bricked scene volume this frame.
@@ -186,6 +224,29 @@ pub struct BrickFrame {
     pub empty: Arc<Vec<(BrickKey, u16)>>,
     /// Whether every wanted brick is among them.
     pub complete: bool,
+    /// The gradient normalisation of each level `0 … C`
+    /// ([`BrickedDataset::gradient_norms`]).
+    pub gradient_norms: Vec<f32>,
+}
+
+impl BrickFrame {
+    /// The level the ray caster samples at `q` (continuous voxel index of the coarse
+    /// level): the finest whose brick there is drawn or marked empty, as the page table
+    /// resolves it (`render::bricked::page_table`: the level-0 brick `b₀` holding the
+    /// point, clamped to the volume, and at level `k` its ancestor `b₀ / 2ᵏ`). `None`
+    /// outside the volume's box.
+    pub fn level_at(&self, q: Vec3) -> Option<usize> {
+        let d0 = self.table_dims.first()?.as_vec3();
+        let q0 = (q + 0.5) * (1u32 << self.coarse) as f32 - 0.5;
+        if !(q0.cmpge(Vec3::splat(-0.5)).all() && q0.cmple(d0 - 0.5).all()) {
+            return None;
+        }
+        let size = self.layout.size as f32;
+        let last = self.layout.bricks(d0.as_uvec3()).saturating_sub(UVec3::ONE);
+        let b0 = ((q0.clamp(Vec3::ZERO, d0 - 1.0) + 0.5) / size).floor().as_uvec3().min(last);
+        let present = |k: BrickKey| self.drawn.iter().any(|(d, ..)| *d == k) || self.empty.iter().any(|(e, _)| *e == k);
+        (0..=self.coarse).find(|&k| present(BrickKey::new(k, b0 >> k as u32)))
+    }
 }
 
 /// The bricked frames of [`crate::dataset::SceneRegions`]' volumes (same order; `None`
@@ -240,6 +301,68 @@ mod tests {
     use super::*;
     use crate::volume::{Grid, Source, ValueMap, Voxels};
 
+    /// A source whose levels' origins are all level 0's (sampled, not averaged).
+    struct Sampled(Arc<dyn VoxelSource>, crate::volume::source::SourceInfo);
+
+    impl VoxelSource for Sampled {
+        fn info(&self) -> &crate::volume::source::SourceInfo {
+            &self.1
+        }
+
+        fn read_box(&self, level: usize, lo: UVec3, size: UVec3) -> Result<crate::volume::source::Block, SourceError> {
+            self.0.read_box(level, lo, size)
+        }
+    }
+
+    #[test]
+    fn levels_that_do_not_nest_are_not_streamed() {
+        let dims = UVec3::new(80, 70, 66);
+        let v = Volume::new("zeros", Grid::new(dims, Vec3::new(0.5, 0.5, 2.0)), Voxels::U8(vec![0; (80 * 70 * 66) as usize]), ValueMap::IDENTITY, Source::default())
+            .expect("volume");
+        let nested: Arc<dyn VoxelSource> = Arc::new(MemorySource::new(Arc::new(v), 16));
+        assert!(matches!(BrickedDataset::open(nested.clone(), 1 << 20), Ok(Ok(_))), "averaged levels nest");
+        let mut info = nested.info().clone();
+        let origin = info.levels[0].grid.origin;
+        for l in &mut info.levels {
+            l.grid.origin = origin;
+        }
+        let Ok(Err(why)) = BrickedDataset::open(Arc::new(Sampled(nested, info)), 1 << 20) else { panic!("streamed") };
+        assert!(why.contains("level 1") && why.contains("centred"), "{why}");
+    }
+
+    #[test]
+    fn the_level_at_a_point_is_the_finest_brick_present_there() {
+        let layout = BrickLayout::new(8, 1);
+        let data = Arc::new(BrickData::new(layout, crate::volume::source::Block { voxels: Voxels::U8(vec![1; 1000]), faults: Vec::new() }));
+        // Level 0 of 40 × 20 × 20 voxels, coarse level 2 (10 × 5 × 5): bricks of level 0
+        // (5 × 3 × 3) … level 2 (2 × 1 × 1).
+        let frame = |drawn: &[BrickKey], empty: &[BrickKey]| BrickFrame {
+            table_dims: vec![UVec3::new(40, 20, 20), UVec3::new(20, 10, 10), UVec3::new(10, 5, 5)],
+            layout,
+            coarse: 2,
+            bits: 8,
+            drawn: Arc::new(drawn.iter().map(|k| (*k, data.clone(), u64::MAX)).collect()),
+            empty: Arc::new(empty.iter().map(|k| (*k, 0)).collect()),
+            complete: false,
+            gradient_norms: vec![1.0; 3],
+        };
+        let coarse = [BrickKey::new(2, UVec3::ZERO), BrickKey::new(2, UVec3::X)];
+        let f = frame(&[coarse[0], coarse[1], BrickKey::new(1, UVec3::new(1, 0, 0))], &[BrickKey::new(0, UVec3::new(3, 1, 0))]);
+        // Coarse voxel 1 → level-0 index (1.5 · 4 − 0.5) = 5.5: level-0 brick 0, level-1
+        // brick 0: only the coarse brick.
+        assert_eq!(f.level_at(Vec3::new(1.0, 1.0, 1.0)), Some(2));
+        // Coarse x 4.2 → level 0 x 18.3: brick 2 of level 0, brick 1 of level 1 (drawn).
+        assert_eq!(f.level_at(Vec3::new(4.2, 1.0, 1.0)), Some(1));
+        // Coarse (6.3, 2.0, 0.2) → level 0 (26.7, 9.5, 2.3): brick (3, 1, 0), marked empty.
+        assert_eq!(f.level_at(Vec3::new(6.3, 2.0, 0.2)), Some(0));
+        // Past the box (coarse x ≥ 9.5) nothing; at its last voxel (level 0 x 39) the last
+        // coarse brick.
+        assert_eq!(f.level_at(Vec3::new(9.6, 1.0, 1.0)), None);
+        assert_eq!(f.level_at(Vec3::new(9.4, 1.0, 1.0)), Some(2));
+        assert_eq!(frame(&[coarse[0]], &[]).level_at(Vec3::new(9.4, 1.0, 1.0)), None, "its coarse brick missing");
+        assert_eq!(frame(&[], &[]).level_at(Vec3::ONE), None, "nothing drawn: no level");
+    }
+
     #[test]
     fn the_coarse_level_is_cut_into_the_bricks_the_source_gives() {
         let dims = UVec3::new(150, 90, 70);
@@ -258,5 +381,49 @@ mod tests {
             assert!(data.voxels == block.voxels, "brick {k:?} differs from the source's");
             assert_eq!(data.range, crate::volume::source::brick::code_range(&block.voxels));
         }
+        // The coarse level's largest gradient, from its bricks, is the whole volume's.
+        let g = bricked.gradient_max[1];
+        assert!((g - coarse.gradient_max()).abs() < 1e-6 && g > 0.0, "{g} vs {}", coarse.gradient_max());
+        assert_eq!(bricked.gradient_max[0], 0.0, "no level-0 brick seen yet");
+        assert_eq!(bricked.gradient_norms(), vec![g, g], "an unseen level takes the coarser one's");
+    }
+
+    #[test]
+    fn a_levels_gradient_normalisation_is_the_largest_of_its_bricks_seen() {
+        let dims = UVec3::new(70, 40, 36);
+        let code = |p: UVec3| (((p.x * 37 + p.y * 11 + p.z * 5) % 23) * 100 + p.x * 3) as u16;
+        let codes: Vec<u16> =
+            (0..dims.z).flat_map(|z| (0..dims.y).flat_map(move |y| (0..dims.x).map(move |x| code(UVec3::new(x, y, z))))).collect();
+        let v =
+            Volume::new("ramp", Grid::new(dims, Vec3::ONE), Voxels::U16(codes), ValueMap::IDENTITY, Source::default()).expect("volume");
+        let source: Arc<dyn VoxelSource> = Arc::new(MemorySource::new(Arc::new(v), 16));
+        let Ok(Ok((mut bricked, _))) = BrickedDataset::open(source.clone(), 1 << 20) else { panic!("streamed") };
+        // Brick (1, 0, 0) of level 0 owns x 32 … 63, y and z 0 … 31: central differences
+        // of the codes (edges clamped) over 65535, worked out here without the sampler.
+        let at = |x: i64, y: i64, z: i64| {
+            let c = |v: i64, n: u32| v.clamp(0, n as i64 - 1) as u32;
+            code(UVec3::new(c(x, dims.x), c(y, dims.y), c(z, dims.z))) as f32 / 65535.0
+        };
+        let mut expected = 0.0f32;
+        for z in 0..32i64 {
+            for y in 0..32i64 {
+                for x in 32..64i64 {
+                    let g = Vec3::new(at(x + 1, y, z) - at(x - 1, y, z), at(x, y + 1, z) - at(x, y - 1, z), at(x, y, z + 1) - at(x, y, z - 1));
+                    expected = expected.max((g * 0.5).length());
+                }
+            }
+        }
+        let key = BrickKey::new(0, UVec3::new(1, 0, 0));
+        let Ok(block) = BRICK.read(source.as_ref(), 0, key.coords()) else { panic!("brick") };
+        let brick = BrickData::new(BRICK, block);
+        assert!((brick.gradient_max - expected).abs() < 1e-6, "{} vs {expected}", brick.gradient_max);
+        assert!(bricked.see_gradients([(key, &brick)]));
+        assert!(!bricked.see_gradients([(key, &brick)]), "seen again: nothing grew");
+        assert_eq!(bricked.gradient_norms()[0], expected);
+        // A level's normalisation never shrinks (a flatter brick seen later keeps it).
+        let flat = BrickData::new(BRICK, crate::volume::source::Block { voxels: Voxels::U16(vec![7; 36 * 36 * 36]), faults: Vec::new() });
+        assert_eq!(flat.gradient_max, 0.0);
+        assert!(!bricked.see_gradients([(BrickKey::new(0, UVec3::ZERO), &flat)]));
+        assert_eq!(bricked.gradient_norms()[0], expected);
     }
 }

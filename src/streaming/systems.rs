@@ -85,7 +85,7 @@ impl VisibilityTests {
 
 /// Asks for the bricks the views want and publishes what to draw ([`BrickedScene`]).
 pub fn stream_bricks(
-    datasets: Query<(&Dataset, &BrickedDataset)>,
+    mut datasets: Query<(&Dataset, &mut BrickedDataset)>,
     regions: Res<SceneRegions>,
     views: Query<(&ViewLenses, &VolumeView)>,
     budget: Res<StreamBudget>,
@@ -98,7 +98,7 @@ pub fn stream_bricks(
     let mut volumes = vec![None; scene.volumes.len()];
     let (mut want_total, mut resident_total, mut pending, mut failed, mut finest, mut count) = (0, 0, 0, 0, None::<usize>, 0);
     for (v, entity) in regions.datasets.iter().enumerate() {
-        let Ok((dataset, bricked)) = datasets.get(*entity) else { continue };
+        let Ok((dataset, mut bricked)) = datasets.get_mut(*entity) else { continue };
         let Some(volume) = scene.volumes.get(v) else { continue };
         let bits = bricked.bits();
         count += 1;
@@ -119,10 +119,11 @@ pub fn stream_bricks(
         let looks: Vec<&Appearance> =
             scene.regions.iter().filter(|r| r.volume == v).filter_map(|r| scene.appearances.get(r.appearance)).collect();
         let tests = visibility.of(volume, &looks);
-        let (mut drawn, mut empty) = (Vec::new(), Vec::new());
+        let (mut drawn, mut empty, mut seen_gradients) = (Vec::new(), Vec::new(), Vec::new());
         // The coarse level's bricks (always at hand), then the streamed ones present.
         let coarse = bricked.coarse_bricks.iter().map(|(k, d)| (*k, d.clone()));
         for (k, data) in coarse.chain(keys.into_iter().filter_map(|(_, k)| bricked.cache.get(k).map(|d| (k, d)))) {
+            seen_gradients.push((k, data.clone()));
             let shows = |(lo, hi): (u16, u16)| tests.as_ref().is_none_or(|t| t.is_empty() || t.iter().any(|f| f(lo, hi)));
             let mask = if shows(data.range) {
                 data.sub_ranges.iter().enumerate().filter(|(_, r)| shows(**r)).fold(0u64, |m, (i, _)| m | 1 << i)
@@ -143,7 +144,15 @@ pub fn stream_bricks(
         pending += stats.pending;
         failed += stats.failed;
         for (k, e) in bricked.cache.errors() {
-            warn!("{}: brick {:?} of level {}: {e}; drawn from a coarser level", dataset.volume.name, k.brick, k.level);
+            warn!("{e} (brick {:?} of level {} of {}; drawn from a coarser level)", k.brick, k.level, dataset.volume.name);
+        }
+        for (k, faults) in bricked.cache.faulted() {
+            warn!("{faults} (brick {:?} of level {} of {})", k.brick, k.level, dataset.volume.name);
+        }
+        // (Written only when a level's largest gradient grew: the component's change
+        // ticks stay quiet otherwise.)
+        if bricked.bypass_change_detection().see_gradients(seen_gradients.iter().map(|(k, d)| (*k, d.as_ref()))) {
+            bricked.set_changed();
         }
         volumes[v] = Some(BrickFrame {
             table_dims: bricked.table_dims(),
@@ -151,6 +160,7 @@ pub fn stream_bricks(
             coarse: bricked.coarse,
             bits,
             complete: resident == want.len(),
+            gradient_norms: bricked.gradient_norms(),
             drawn: std::sync::Arc::new(drawn),
             empty: std::sync::Arc::new(empty),
         });

@@ -42,6 +42,7 @@ impl Plugin for FocalAppPlugin {
             .init_resource::<window_tools::WindowTools>()
             .init_resource::<explode_tools::ExplodeUi>()
             .init_resource::<explode_overlay::CutPreview>()
+            .init_resource::<super::streaming_status::LevelUnderCursor>()
             .add_systems(
                 Startup,
                 move |mut commands: Commands, mut egui: ResMut<EguiGlobalSettings>, mut load: MessageWriter<LoadRequest>| {
@@ -73,7 +74,11 @@ impl Plugin for FocalAppPlugin {
                     .chain(),
             )
             // The exploded views' physics: as many steps as the frame's time asks for.
-            .add_systems(Update, (crate::explode::systems::run_steps, open_explode_panel).after(orbit::apply_orbit))
+            .add_systems(
+                Update,
+                (crate::explode::systems::run_steps, open_explode_panel, super::streaming_status::level_under_cursor)
+                    .after(orbit::apply_orbit),
+            )
             .add_systems(
                 EguiPrimaryContextPass,
                 (panels::ui, explode_panel::explode_panel, explode_overlay::explode_overlay, super::streaming_status::streaming_status)

@@ -148,13 +148,21 @@ impl<'a> VolumeSampler<'a> {
 /// Largest gradient magnitude over all voxel centres of `voxels` on a `dims` grid
 /// (normalised units per voxel).
 pub fn max_gradient_magnitude(voxels: &Voxels, dims: UVec3) -> f32 {
+    max_gradient_magnitude_in(voxels, dims, UVec3::ZERO, dims)
+}
+
+/// Largest gradient magnitude over the voxel centres `lo ≤ p < hi` of `voxels` on a
+/// `dims` grid (central differences, edges clamped): a brick's owned voxels inside its
+/// apron give the same gradients as the whole level would.
+pub fn max_gradient_magnitude_in(voxels: &Voxels, dims: UVec3, lo: UVec3, hi: UVec3) -> f32 {
     let sampler = VolumeSampler::new(voxels, dims);
-    (0..dims.z)
+    let hi = hi.min(dims);
+    (lo.z..hi.z)
         .into_par_iter()
         .map(|z| {
             let mut best = 0.0f32;
-            for y in 0..dims.y {
-                for x in 0..dims.x {
+            for y in lo.y..hi.y {
+                for x in lo.x..hi.x {
                     let g = sampler.gradient(UVec3::new(x, y, z).as_vec3());
                     best = best.max(g.length());
                 }

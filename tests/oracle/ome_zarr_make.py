@@ -99,7 +99,16 @@ def main(out):
     omero = {"channels": [{"window": {"min": -100.0, "max": 500.0, "start": 0.0, "end": 400.0}}]}
     write(out / "v3_float32_nan.ome.zarr", 3, [e], {"ome": {"version": "0.5", "multiscales": [ms], "omero": omero}},
           chunks=(2, 3, 4), compressors=ZstdCodec(level=3))
-    print(f"wrote 5 pyramids with zarr-python {zarr.__version__} into {out}")
+    # (f) A float32 NIfTI (nibabel) for `focal convert`: values that are not whole
+    # numbers (written as float32, Focal's 16-bit codes of them), anisotropic voxels and
+    # an origin away from 0.
+    import nibabel
+    x, y, z = np.meshgrid(np.arange(21), np.arange(17), np.arange(12), indexing="ij")
+    f = (1000.0 * np.sin(0.3 * x) * np.cos(0.2 * y) + 37.25 * z - 0.5).astype(np.float32)
+    affine = np.diag([0.7, 0.8, 1.2, 1.0])
+    affine[:3, 3] = [-20.0, 15.0, 7.5]
+    nibabel.save(nibabel.Nifti1Image(f, affine), str(out / "float32_source.nii.gz"))
+    print(f"wrote 5 pyramids with zarr-python {zarr.__version__} and a float32 NIfTI into {out}")
 
 
 if __name__ == "__main__":

@@ -31,6 +31,11 @@ use crate::volume::source::cache::BrickKey;
 /// Words before the directory.
 pub const PAGE_HEADER: usize = 8;
 
+/// Words before each volume's page tree: the gradient normalisation of its levels
+/// `0 … C` as `f32` bits (`BrickFrame::gradient_norms`; levels are 4 bits of a page
+/// word, so at most 16).
+pub const GRADIENT_NORMS: usize = 16;
+
 /// Frames without any bricked volume after which the atlas is given back (hiding a
 /// bricked volume for a moment, or switching between it and another, keeps its bricks).
 pub const RELEASE_AFTER_FRAMES: u32 = 600;
@@ -154,6 +159,8 @@ pub fn upload_bricks(
         }
         coarse_in_atlas &= frame.drawn.iter().all(|(k, ..)| k.level as usize != frame.coarse || drawn.contains_key(k));
         let tree = PageTree::build(&frame.table_dims, frame.layout, &drawn, slots.grid);
+        let norm = |k: usize| frame.gradient_norms.get(k.min(frame.coarse)).copied().unwrap_or(1.0);
+        words.extend((0..GRADIENT_NORMS).map(|k| norm(k).to_bits()));
         words[dir_at + i] = words.len() as u32;
         words.extend(tree.words);
     }

@@ -89,6 +89,9 @@ pub fn write(volume: &Volume, out: &Path, opts: &WriteOptions, progress: &(dyn F
     let total: u64 = dims.iter().map(|d| d.x as u64 * d.y as u64 * d.z as u64).sum();
     let done = AtomicU64::new(0);
     let count = |voxels: u64| progress(done.fetch_add(voxels, Ordering::Relaxed) + voxels, total);
+    // A group without the multiscales first: a conversion that stops half way leaves a
+    // Zarr group that `--force` may replace, and that no reader takes for a pyramid.
+    store_group(&store, out, opts, serde_json::Map::new())?;
     let mut above: Option<crate::volume::pyramid::Level> = None;
     for k in 0..n {
         let (voxels, d) = match &above {
@@ -101,14 +104,23 @@ pub fn write(volume: &Volume, out: &Path, opts: &WriteOptions, progress: &(dyn F
             above = Some(next_level(voxels, d, opts.downsample));
         }
     }
-    let attributes = group_attributes(volume, &dims, sample, opts);
+    store_group(&store, out, opts, group_attributes(volume, &dims, sample, opts))?;
+    Ok(Written { levels: dims, sample })
+}
+
+/// Writes the root group's metadata with `attributes`.
+fn store_group(
+    store: &ReadableWritableListableStorage,
+    out: &Path,
+    opts: &WriteOptions,
+    attributes: serde_json::Map<String, serde_json::Value>,
+) -> Result<(), String> {
     let group = match opts.version {
-        ZarrVersion::V3 => Group::new_with_metadata(store, "/", GroupMetadata::V3(GroupMetadataV3::new().with_attributes(attributes))),
-        ZarrVersion::V2 => Group::new_with_metadata(store, "/", GroupMetadata::V2(GroupMetadataV2::new().with_attributes(attributes))),
+        ZarrVersion::V3 => Group::new_with_metadata(store.clone(), "/", GroupMetadata::V3(GroupMetadataV3::new().with_attributes(attributes))),
+        ZarrVersion::V2 => Group::new_with_metadata(store.clone(), "/", GroupMetadata::V2(GroupMetadataV2::new().with_attributes(attributes))),
     }
     .map_err(|e| format!("{}: {e}", out.display()))?;
-    group.store_metadata().map_err(|e| format!("{}: {e}", out.display()))?;
-    Ok(Written { levels: dims, sample })
+    group.store_metadata().map_err(|e| format!("{}: {e}", out.display()))
 }
 
 /// Makes `out` an empty folder, refusing to replace anything that is not a Zarr group.

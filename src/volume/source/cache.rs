@@ -52,6 +52,11 @@ pub struct BrickData {
     pub range: (u16, u16),
     /// The same per 8³ sub-block ([`BrickLayout::sub_ranges`]).
     pub sub_ranges: Vec<(u16, u16)>,
+    /// Largest gradient magnitude over its owned voxels (normalised units per voxel of
+    /// its level; the apron holds their neighbours): the context-preserving and
+    /// gradient-modulated looks normalise by the largest of a level's
+    /// (`streaming::bricked::BrickedDataset::gradient_max`).
+    pub gradient_max: f32,
     /// Chunks of it that could not be read.
     pub faults: Vec<Fault>,
 }
@@ -62,6 +67,10 @@ impl BrickData {
         BrickData {
             range: code_range(&block.voxels),
             sub_ranges: layout.sub_ranges(&block.voxels),
+            gradient_max: {
+                let (n, a) = (UVec3::splat(layout.stored()), UVec3::splat(layout.apron));
+                crate::volume::sample::max_gradient_magnitude_in(&block.voxels, n, a, a + layout.size)
+            },
             voxels: block.voxels,
             faults: block.faults,
         }
@@ -102,6 +111,8 @@ struct State {
     refused: HashSet<BrickKey>,
     finished: Vec<BrickKey>,
     errors: Vec<(BrickKey, SourceError)>,
+    /// Bricks that loaded with chunks drawn at the fill value, and what failed.
+    faulted: Vec<(BrickKey, String)>,
     clock: u64,
     bytes: u64,
     loaded: u64,
@@ -192,12 +203,18 @@ impl BrickCache {
                 let read =
                     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| layout.read(source.as_ref(), k.level as usize, k.coords())));
                 let result = read.unwrap_or_else(|_| {
-                    Err(SourceError::new(&source.info().name, format!("reading brick {:?} of level {} panicked", k.brick, k.level)))
+                    Err(SourceError::new(&source.info().location(), format!("reading brick {:?} of level {} panicked", k.brick, k.level)))
                 });
                 let mut s = lock(&state);
                 s.pending.remove(&k);
                 match result {
                     Ok(block) => {
+                        // (Chunks absent from the store are the fill value by the Zarr
+                        // specification: a sparse pyramid is full of them.)
+                        if block.faults.iter().any(|f| f.kind != super::FaultKind::Absent) {
+                            let faults = super::level::summarize(&block.faults).unwrap_or_default();
+                            s.faulted.push((k, format!("{}: {faults}", source.info().location())));
+                        }
                         insert(&mut s, k, Arc::new(BrickData::new(layout, block)), budget, pinned);
                         s.finished.push(k);
                     }
@@ -219,6 +236,12 @@ impl BrickCache {
     /// Loads that failed since the last call.
     pub fn errors(&self) -> Vec<(BrickKey, SourceError)> {
         std::mem::take(&mut self.lock().errors)
+    }
+
+    /// Bricks loaded since the last call with chunks that could not be read (drawn at
+    /// the fill value there), with the message naming the source and the chunks.
+    pub fn faulted(&self) -> Vec<(BrickKey, String)> {
+        std::mem::take(&mut self.lock().faulted)
     }
 
     pub fn stats(&self) -> CacheStats {
@@ -273,6 +296,7 @@ mod tests {
 
     use super::*;
     use crate::volume::source::procedural::ProceduralSource;
+    use crate::volume::source::{FaultKind, SourceInfo};
 
     fn wait_idle(c: &BrickCache) {
         let start = Instant::now();
@@ -301,6 +325,44 @@ mod tests {
         assert_eq!(d.range, code_range(&direct.voxels));
         assert_eq!(c.stats().resident, 1);
         assert_eq!(c.stats().bytes, 18 * 18 * 18 * 2);
+    }
+
+    /// A source whose level-0 reads come back with one unreadable and one absent chunk.
+    struct Faulty(Arc<dyn VoxelSource>, FaultKind);
+
+    impl VoxelSource for Faulty {
+        fn info(&self) -> &SourceInfo {
+            self.0.info()
+        }
+
+        fn read_box(&self, level: usize, lo: UVec3, size: UVec3) -> Result<Block, SourceError> {
+            let mut block = self.0.read_box(level, lo, size)?;
+            if level == 0 {
+                block.faults.push(Fault { chunk: "0/c/1/2/3".into(), kind: self.1, problem: "gzip: invalid header".into() });
+                block.faults.push(Fault { chunk: "0/c/1/2/4".into(), kind: FaultKind::Absent, problem: "absent".into() });
+            }
+            Ok(block)
+        }
+    }
+
+    #[test]
+    fn a_brick_with_unreadable_chunks_is_drawn_and_named() {
+        let c = BrickCache::new(Arc::new(Faulty(source(), FaultKind::Unreadable)), BrickLayout::new(16, 1), 64 << 20);
+        let (fine, coarse) = (BrickKey::new(0, UVec3::new(1, 2, 3)), BrickKey::new(1, UVec3::ZERO));
+        c.request(&[fine, coarse]);
+        wait_idle(&c);
+        assert!(c.get(fine).is_some(), "drawn from what is there");
+        let faulted = c.faulted();
+        assert_eq!(faulted.len(), 1, "{faulted:?}");
+        let (k, message) = &faulted[0];
+        assert_eq!(*k, fine);
+        assert!(message.contains("procedural") && message.contains("0/c/1/2/3") && message.contains("invalid header"), "{message}");
+        assert!(c.errors().is_empty() && c.stats().failed == 0, "a brick drawn is not a failed load");
+        // Absent chunks alone (a sparse pyramid's empty space) are no fault.
+        let sparse = BrickCache::new(Arc::new(Faulty(source(), FaultKind::Absent)), BrickLayout::new(16, 1), 64 << 20);
+        sparse.request(&[fine]);
+        wait_idle(&sparse);
+        assert!(sparse.get(fine).is_some() && sparse.faulted().is_empty());
     }
 
     #[test]

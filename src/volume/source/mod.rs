@@ -60,6 +60,13 @@ pub struct SourceInfo {
 }
 
 impl SourceInfo {
+    /// Where the voxels come from, for messages: the file, folder or address the source
+    /// was opened from, else its name (an OME-Zarr image's own name may be anything,
+    /// "image" say, which tells a user nothing).
+    pub fn location(&self) -> String {
+        self.source.path.as_ref().map_or_else(|| self.name.clone(), |p| p.display().to_string())
+    }
+
     /// The largest code (normalisation denominator).
     pub fn code_max(&self) -> u32 {
         if self.bits == 8 { u8::MAX as u32 } else { u16::MAX as u32 }
@@ -134,13 +141,13 @@ pub trait VoxelSource: Send + Sync {
 /// Checks that a box lies inside a level of `info` (the common guard of every source).
 pub fn check_box(info: &SourceInfo, level: usize, lo: UVec3, size: UVec3) -> Result<(), SourceError> {
     let Some(l) = info.levels.get(level) else {
-        return Err(SourceError::new(&info.name, format!("level {level} asked for, the pyramid has {}", info.levels.len())));
+        return Err(SourceError::new(&info.location(), format!("level {level} asked for, the pyramid has {}", info.levels.len())));
     };
     let hi = lo.as_u64vec3() + size.as_u64vec3();
     let dims = l.grid.dims.as_u64vec3();
     if size.min_element() == 0 || hi.cmpgt(dims).any() {
         return Err(SourceError::new(
-            &info.name,
+            &info.location(),
             format!("box {lo} + {} lies outside level {level} ({})", fmt_dims(size), fmt_dims(l.grid.dims)),
         ));
     }

@@ -286,11 +286,11 @@ impl ZarrSource {
         }
         match self.encoding {
             Encoding::U8 => put(l, subset, targets, out, |x: u8| Some(x as u16)),
-            Encoding::I8 => put(l, subset, targets, out, |x: i8| Some((x as i16 + 128) as u16)),
+            Encoding::I8 => put(l, subset, targets, out, |x: i8| Some(i8_code(x))),
             Encoding::U16 => put(l, subset, targets, out, |x: u16| Some(x)),
-            Encoding::I16 => put(l, subset, targets, out, |x: i16| Some((x as i32 + 32768) as u16)),
+            Encoding::I16 => put(l, subset, targets, out, |x: i16| Some(i16_code(x))),
             Encoding::Quantised { ty, lo, hi } => {
-                let q = move |x: f64| x.is_finite().then(|| ((x - lo) / (hi - lo) * 65535.0).round().clamp(0.0, 65535.0) as u16);
+                let q = move |x: f64| quantised_code(x, lo, hi);
                 match ty {
                     Wide::U32 => put(l, subset, targets, out, |x: u32| q(x as f64)),
                     Wide::I32 => put(l, subset, targets, out, |x: i32| q(x as f64)),
@@ -301,14 +301,43 @@ impl ZarrSource {
         }
     }
 
-    /// The code of the array's fill value where it is a number, else 0.
-    fn fill_code(&self) -> u16 {
-        match self.encoding {
-            Encoding::I8 => 128,
-            Encoding::I16 => 32768,
-            _ => 0,
-        }
+    /// The code of level `l`'s fill value (what an unreadable chunk is drawn at, as
+    /// zarrs draws an absent one); a fill value that is not a finite number (NaN is
+    /// common for float arrays) takes code 0, as NaN samples do.
+    fn fill_code(&self, l: &Level) -> u16 {
+        let b = l.array.fill_value().as_ne_bytes();
+        let get = |n: usize| b.get(..n).map(<[u8]>::to_vec);
+        let code = match self.encoding {
+            Encoding::U8 => get(1).map(|v| v[0] as u16),
+            Encoding::I8 => get(1).map(|v| i8_code(v[0] as i8)),
+            Encoding::U16 => get(2).map(|v| u16::from_ne_bytes([v[0], v[1]])),
+            Encoding::I16 => get(2).map(|v| i16_code(i16::from_ne_bytes([v[0], v[1]]))),
+            Encoding::Quantised { ty, lo, hi } => {
+                let value = match ty {
+                    Wide::U32 => get(4).map(|v| u32::from_ne_bytes([v[0], v[1], v[2], v[3]]) as f64),
+                    Wide::I32 => get(4).map(|v| i32::from_ne_bytes([v[0], v[1], v[2], v[3]]) as f64),
+                    Wide::F32 => get(4).map(|v| f32::from_ne_bytes([v[0], v[1], v[2], v[3]]) as f64),
+                    Wide::F64 => get(8).map(|v| f64::from_ne_bytes([v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]])),
+                };
+                value.and_then(|x| quantised_code(x, lo, hi))
+            }
+        };
+        code.unwrap_or(0)
     }
+}
+
+/// Codes of signed samples: offset by half the range (the value map subtracts it).
+fn i8_code(x: i8) -> u16 {
+    (x as i16 + 128) as u16
+}
+
+fn i16_code(x: i16) -> u16 {
+    (x as i32 + 32768) as u16
+}
+
+/// The 16-bit code of a wide sample over `[lo, hi]` (clamped); `None` for NaN or ±∞.
+fn quantised_code(x: f64, lo: f64, hi: f64) -> Option<u16> {
+    x.is_finite().then(|| ((x - lo) / (hi - lo) * 65535.0).round().clamp(0.0, 65535.0) as u16)
 }
 
 impl Level {
@@ -343,7 +372,7 @@ impl VoxelSource for ZarrSource {
         check_box(&self.info, level, lo, size)?;
         let l = &self.levels[level];
         let n = size.x as usize * size.y as usize * size.z as usize;
-        let mut codes = vec![self.fill_code(); n];
+        let mut codes = vec![self.fill_code(l); n];
         let mut faults = Vec::new();
         // The read chunks the box touches, along x, y, z.
         let chunk = |axis: usize| l.spatial[axis].map_or(1, |d| l.read_chunk[d]);
