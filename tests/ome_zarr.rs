@@ -184,8 +184,12 @@ fn converted_pyramids_pass_the_independent_check() {
     // Float values (a float32 NIfTI nibabel wrote): a float32 pyramid, checked within the
     // 16-bit codes' steps.
     let fixtures = fixtures().expect("the oracle made its fixtures");
-    let line = convert_and_check(&fixtures.join("float32_source.nii.gz"), &dir.join("float.ome.zarr"), &WriteOptions { chunk: 8, ..Default::default() })
-        .expect("oracle");
+    let line = convert_and_check(
+        &fixtures.join("float32_source.nii.gz"),
+        &dir.join("float.ome.zarr"),
+        &WriteOptions { chunk: 8, ..Default::default() },
+    )
+    .expect("oracle");
     assert!(line.contains("float32"), "{line}");
     // Writing over a pyramid needs the overwrite flag; over anything else it is refused.
     let volume = read_volume(&data("ct/fuel.nii.gz"), &ReadOptions::default()).expect("reads");

@@ -317,8 +317,14 @@ mod tests {
     #[test]
     fn levels_that_do_not_nest_are_not_streamed() {
         let dims = UVec3::new(80, 70, 66);
-        let v = Volume::new("zeros", Grid::new(dims, Vec3::new(0.5, 0.5, 2.0)), Voxels::U8(vec![0; (80 * 70 * 66) as usize]), ValueMap::IDENTITY, Source::default())
-            .expect("volume");
+        let v = Volume::new(
+            "zeros",
+            Grid::new(dims, Vec3::new(0.5, 0.5, 2.0)),
+            Voxels::U8(vec![0; (80 * 70 * 66) as usize]),
+            ValueMap::IDENTITY,
+            Source::default(),
+        )
+        .expect("volume");
         let nested: Arc<dyn VoxelSource> = Arc::new(MemorySource::new(Arc::new(v), 16));
         assert!(matches!(BrickedDataset::open(nested.clone(), 1 << 20), Ok(Ok(_))), "averaged levels nest");
         let mut info = nested.info().clone();
@@ -394,8 +400,7 @@ mod tests {
         let code = |p: UVec3| (((p.x * 37 + p.y * 11 + p.z * 5) % 23) * 100 + p.x * 3) as u16;
         let codes: Vec<u16> =
             (0..dims.z).flat_map(|z| (0..dims.y).flat_map(move |y| (0..dims.x).map(move |x| code(UVec3::new(x, y, z))))).collect();
-        let v =
-            Volume::new("ramp", Grid::new(dims, Vec3::ONE), Voxels::U16(codes), ValueMap::IDENTITY, Source::default()).expect("volume");
+        let v = Volume::new("ramp", Grid::new(dims, Vec3::ONE), Voxels::U16(codes), ValueMap::IDENTITY, Source::default()).expect("volume");
         let source: Arc<dyn VoxelSource> = Arc::new(MemorySource::new(Arc::new(v), 16));
         let Ok(Ok((mut bricked, _))) = BrickedDataset::open(source.clone(), 1 << 20) else { panic!("streamed") };
         // Brick (1, 0, 0) of level 0 owns x 32 … 63, y and z 0 … 31: central differences
@@ -408,7 +413,8 @@ mod tests {
         for z in 0..32i64 {
             for y in 0..32i64 {
                 for x in 32..64i64 {
-                    let g = Vec3::new(at(x + 1, y, z) - at(x - 1, y, z), at(x, y + 1, z) - at(x, y - 1, z), at(x, y, z + 1) - at(x, y, z - 1));
+                    let g =
+                        Vec3::new(at(x + 1, y, z) - at(x - 1, y, z), at(x, y + 1, z) - at(x, y - 1, z), at(x, y, z + 1) - at(x, y, z - 1));
                     expected = expected.max((g * 0.5).length());
                 }
             }

@@ -49,8 +49,8 @@ pub fn level_under_cursor(
         *under = LevelUnderCursor::default();
         return;
     };
-    let stale = regions.is_changed()
-        || under.picked_for.as_ref().is_none_or(|(at, picked)| at.distance(cursor) > 0.5 || *picked != lenses.lenses);
+    let stale =
+        regions.is_changed() || under.picked_for.as_ref().is_none_or(|(at, picked)| at.distance(cursor) > 0.5 || *picked != lenses.lenses);
     if stale {
         let (px, py) = (cursor.x * screen.width / size.x.max(1.0), cursor.y * screen.height / size.y.max(1.0));
         let hit = lens_ray(&view, screen, &lenses.lenses, px, py)

@@ -116,8 +116,12 @@ fn store_group(
     attributes: serde_json::Map<String, serde_json::Value>,
 ) -> Result<(), String> {
     let group = match opts.version {
-        ZarrVersion::V3 => Group::new_with_metadata(store.clone(), "/", GroupMetadata::V3(GroupMetadataV3::new().with_attributes(attributes))),
-        ZarrVersion::V2 => Group::new_with_metadata(store.clone(), "/", GroupMetadata::V2(GroupMetadataV2::new().with_attributes(attributes))),
+        ZarrVersion::V3 => {
+            Group::new_with_metadata(store.clone(), "/", GroupMetadata::V3(GroupMetadataV3::new().with_attributes(attributes)))
+        }
+        ZarrVersion::V2 => {
+            Group::new_with_metadata(store.clone(), "/", GroupMetadata::V2(GroupMetadataV2::new().with_attributes(attributes)))
+        }
     }
     .map_err(|e| format!("{}: {e}", out.display()))?;
     group.store_metadata().map_err(|e| format!("{}: {e}", out.display()))

@@ -40,14 +40,14 @@ impl BrickLayout {
     pub fn read(&self, source: &dyn VoxelSource, level: usize, b: UVec3) -> Result<Block, SourceError> {
         let info = source.info();
         let Some(l) = info.levels.get(level) else {
-            return Err(SourceError::new(&info.location(), format!("level {level} asked for, the pyramid has {}", info.levels.len())));
+            return Err(SourceError::new(info.location(), format!("level {level} asked for, the pyramid has {}", info.levels.len())));
         };
         let dims = l.grid.dims;
         let want_lo = (b * self.size).as_ivec3() - self.apron as i32;
         let lo = want_lo.max(glam::IVec3::ZERO).as_uvec3();
         let hi = ((b + 1) * self.size + self.apron).min(dims);
         if lo.cmpge(hi).any() {
-            return Err(SourceError::new(&info.location(), format!("brick {b} lies outside level {level}")));
+            return Err(SourceError::new(info.location(), format!("brick {b} lies outside level {level}")));
         }
         let inner = source.read_box(level, lo, hi - lo)?;
         let n = self.stored();

@@ -203,7 +203,7 @@ impl BrickCache {
                 let read =
                     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| layout.read(source.as_ref(), k.level as usize, k.coords())));
                 let result = read.unwrap_or_else(|_| {
-                    Err(SourceError::new(&source.info().location(), format!("reading brick {:?} of level {} panicked", k.brick, k.level)))
+                    Err(SourceError::new(source.info().location(), format!("reading brick {:?} of level {} panicked", k.brick, k.level)))
                 });
                 let mut s = lock(&state);
                 s.pending.remove(&k);

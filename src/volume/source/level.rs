@@ -23,7 +23,7 @@ pub fn finest_within(info: &SourceInfo, max_bytes: u64) -> usize {
 pub fn read_level(source: &dyn VoxelSource, level: usize, done: &(dyn Fn(u64) + Sync)) -> Result<(Volume, Vec<Fault>), SourceError> {
     let info = source.info();
     let Some(l) = info.levels.get(level) else {
-        return Err(SourceError::new(&info.location(), format!("level {level} asked for, the pyramid has {}", info.levels.len())));
+        return Err(SourceError::new(info.location(), format!("level {level} asked for, the pyramid has {}", info.levels.len())));
     };
     let dims = l.grid.dims;
     let depth = l.chunk.z.clamp(1, dims.z);
@@ -45,7 +45,7 @@ pub fn read_level(source: &dyn VoxelSource, level: usize, done: &(dyn Fn(u64) + 
         match (&mut voxels, block.voxels) {
             (Voxels::U8(all), Voxels::U8(part)) => all.extend(part),
             (Voxels::U16(all), Voxels::U16(part)) => all.extend(part),
-            _ => return Err(SourceError::new(&info.location(), "a slab came back with codes of another width")),
+            _ => return Err(SourceError::new(info.location(), "a slab came back with codes of another width")),
         }
     }
     let mut source_facts = info.source.clone();
@@ -53,7 +53,7 @@ pub fn read_level(source: &dyn VoxelSource, level: usize, done: &(dyn Fn(u64) + 
         source_facts.details.push(("level shown".into(), format!("{level} of {}", info.levels.len())));
     }
     let volume = Volume::new(info.name.clone(), l.grid.clone(), voxels, info.values.clone(), source_facts)
-        .map_err(|e| SourceError::new(&info.location(), e))?;
+        .map_err(|e| SourceError::new(info.location(), e))?;
     Ok((volume, faults))
 }
 

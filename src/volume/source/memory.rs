@@ -55,7 +55,7 @@ impl VoxelSource for MemorySource {
         check_box(&self.info, level, lo, size)?;
         let dims = self.info.levels[level].grid.dims;
         let Some(voxels) = self.level_voxels(level) else {
-            return Err(SourceError::new(&self.info.location(), format!("level {level} is missing")));
+            return Err(SourceError::new(self.info.location(), format!("level {level} is missing")));
         };
         Ok(Block { voxels: copy_box(voxels, dims, lo, size), faults: Vec::new() })
     }

@@ -141,13 +141,13 @@ pub trait VoxelSource: Send + Sync {
 /// Checks that a box lies inside a level of `info` (the common guard of every source).
 pub fn check_box(info: &SourceInfo, level: usize, lo: UVec3, size: UVec3) -> Result<(), SourceError> {
     let Some(l) = info.levels.get(level) else {
-        return Err(SourceError::new(&info.location(), format!("level {level} asked for, the pyramid has {}", info.levels.len())));
+        return Err(SourceError::new(info.location(), format!("level {level} asked for, the pyramid has {}", info.levels.len())));
     };
     let hi = lo.as_u64vec3() + size.as_u64vec3();
     let dims = l.grid.dims.as_u64vec3();
     if size.min_element() == 0 || hi.cmpgt(dims).any() {
         return Err(SourceError::new(
-            &info.location(),
+            info.location(),
             format!("box {lo} + {} lies outside level {level} ({})", fmt_dims(size), fmt_dims(l.grid.dims)),
         ));
     }
