@@ -205,17 +205,26 @@ impl BrickCache {
                 let result = read.unwrap_or_else(|_| {
                     Err(SourceError::new(source.info().location(), format!("reading brick {:?} of level {} panicked", k.brick, k.level)))
                 });
+                // Decoded before the lock is taken: BrickData::new runs rayon work, and
+                // a rayon worker waiting on it may steal another load of this cache,
+                // which would then wait on the lock this job holds (a deadlock that hung
+                // the bricked renders).
+                let result = result.map(|block| {
+                    let faults = block.faults.iter().any(|f| f.kind != super::FaultKind::Absent).then(|| {
+                        format!("{}: {}", source.info().location(), super::level::summarize(&block.faults).unwrap_or_default())
+                    });
+                    (faults, Arc::new(BrickData::new(layout, block)))
+                });
                 let mut s = lock(&state);
                 s.pending.remove(&k);
                 match result {
-                    Ok(block) => {
+                    Ok((faults, data)) => {
                         // (Chunks absent from the store are the fill value by the Zarr
                         // specification: a sparse pyramid is full of them.)
-                        if block.faults.iter().any(|f| f.kind != super::FaultKind::Absent) {
-                            let faults = super::level::summarize(&block.faults).unwrap_or_default();
-                            s.faulted.push((k, format!("{}: {faults}", source.info().location())));
+                        if let Some(faults) = faults {
+                            s.faulted.push((k, faults));
                         }
-                        insert(&mut s, k, Arc::new(BrickData::new(layout, block)), budget, pinned);
+                        insert(&mut s, k, data, budget, pinned);
                         s.finished.push(k);
                     }
                     Err(e) => {
@@ -308,6 +317,24 @@ mod tests {
 
     fn source() -> Arc<dyn VoxelSource> {
         Arc::new(ProceduralSource::new(UVec3::splat(256), Vec3::splat(0.01)).expect("source"))
+    }
+
+    #[test]
+    fn many_loads_on_the_rayon_pool_all_finish() {
+        // Every brick of a 256³ source at once, on the default (rayon) spawner: each
+        // load decodes with rayon work of its own, so a load that held the cache's lock
+        // while it waited for that work deadlocked here (a worker stole another load).
+        // (It took a few rounds to hang on two cores; without the fix the test hangs,
+        // as the lock is held, rather than failing.)
+        let layout = BrickLayout::new(32, 1);
+        let keys: Vec<BrickKey> =
+            (0..8u32 * 8 * 8).map(|i| BrickKey::new(0, UVec3::new(i % 8, i / 8 % 8, i / 64))).collect();
+        for _ in 0..20 {
+            let c = BrickCache::new(source(), layout, 1 << 30);
+            c.request(&keys);
+            wait_idle(&c);
+            assert_eq!(c.stats().resident, keys.len());
+        }
     }
 
     #[test]
