@@ -344,7 +344,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 26] = [
+    let tests: [GpuTest; 28] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -371,6 +371,8 @@ fn main() {
         ("a_selection_on_its_own_grid_matches_the_reference", explode::a_selection_on_its_own_grid_matches_the_reference),
         ("bricked_ch2_converges_to_the_chosen_level_in_memory", bricked::bricked_ch2_converges_to_the_chosen_level_in_memory),
         ("two_level_on_bricked_data_matches_memory", bricked::two_level_on_bricked_data_matches_memory),
+        ("exploded_parts_on_bricked_data_match_memory", bricked::exploded_parts_on_bricked_data_match_memory),
+        ("context_on_bricked_data_normalises_by_the_levels_gradients", bricked::context_on_bricked_data_normalises_by_the_levels_gradients),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

@@ -167,3 +167,86 @@ pub fn two_level_on_bricked_data_matches_memory(gpu: &mut Gpu) {
     let plain = gpu.show(ct, Appearance { segmentation: None, ..look }, &camera);
     assert!(difference(&plain, &memory).0 > 2.0, "the segmentation changed little: the test shows nothing");
 }
+
+/// An exploded view on bricked data: the 128³ head phantom's CT streamed from a pyramid
+/// in memory (coarse level 1), cut into two halves with the right one pushed aside
+/// (placed by hand: headless apps step no physics), against the same two parts of the
+/// CT in memory. Each part samples the bricks through the inverse of its motion.
+pub fn exploded_parts_on_bricked_data_match_memory(gpu: &mut Gpu) {
+    use focal::explode::systems::{spawn_part, volume_polyhedron};
+    use focal::explode::{Exploded, Part};
+    use focal::region::Plane;
+    let ct = Arc::new(Phantom::Head.generate(128).expect("the head phantom"));
+    let skin = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").expect("a built-in preset"));
+    let source: Arc<dyn VoxelSource> = Arc::new(focal::volume::source::memory::MemorySource::new(ct.clone(), 32));
+    let centre = ct.grid.center();
+    let extent = ct.grid.extent().max_element();
+    // (Near enough for level 0: a wider view, 1.6 extents high, wants the coarse level
+    // alone and would test nothing streamed.)
+    let aim = centre + Vec3::X * 0.15 * extent;
+    let eye = aim + Vec3::new(0.2, -1.0, 0.3).normalize() * 2.0 * extent;
+    let camera = FocalCamera::look_at(eye, aim, Vec3::Z, FocalProjection::Orthographic { height: 0.9 * extent });
+    // The two halves of `volume`'s box, split at the middle, the right one moved by 0.3
+    // of the extent along x.
+    let halves = |world: &mut World, data: Entity, volume: &Volume| {
+        let whole = volume_polyhedron(volume).expect("a box");
+        let (left, right) = whole.split(Plane { normal: Vec3::X, offset: centre.x }).expect("two halves");
+        spawn_part(world, Part::new(data, left), Transform::default());
+        spawn_part(world, Part::new(data, right), Transform::from_translation(Vec3::X * 0.3 * extent));
+    };
+
+    gpu.clear();
+    let (bricked, coarse) = BrickedDataset::open(source.clone(), 256 << 20).expect("readable").expect("streamed");
+    assert_eq!(bricked.coarse, 1);
+    let coarse = Arc::new(coarse);
+    let world = gpu.off.world_mut();
+    let data = world.spawn((Dataset::new(coarse.clone(), skin.clone()), Transform::default(), Exploded::default(), bricked)).id();
+    halves(world, data, &coarse);
+    gpu.off.set_camera(&camera);
+    let streamed = gpu.off.capture().unwrap_or_else(|e| panic!("{e}"));
+    let status = gpu.off.world_mut().resource::<StreamStatus>().clone();
+    assert!(status.converged(), "streaming did not converge: {:?}", status.counts());
+    assert_eq!(status.counts().finest_wanted, Some(0), "{:?}", status.counts());
+    let features = gpu.off.shader_features().unwrap_or(0);
+    assert_ne!(features & BRICKED_ONLY, 0, "both parts sample the brick atlas alone (features {features:#x})");
+
+    gpu.clear();
+    let world = gpu.off.world_mut();
+    let data = world.spawn((Dataset::new(ct.clone(), skin.clone()), Transform::default(), Exploded::default())).id();
+    halves(world, data, &ct);
+    gpu.off.set_camera(&camera);
+    let memory = gpu.off.capture().unwrap_or_else(|e| panic!("{e}"));
+    assert_matches("bricked_exploded", &streamed, &memory);
+    // Not the whole head: the parts moved.
+    let whole = gpu.show(ct, skin, &camera);
+    assert!(difference(&whole, &memory).0 > 2.0, "the halves did not move apart: the test shows nothing");
+    gpu.clear();
+}
+
+/// Context-preserving rendering of the 128³ head phantom's noisy CT streamed bricked
+/// (coarse level 1) in a view that wants level 0: its gradients are normalised by the
+/// largest of level 0's bricks (`BrickedDataset::gradient_max`), as the CT in memory
+/// normalises by its own, not by the coarse level's (per voxel of its level, the coarse
+/// level's largest gradient is 1.6 times level 0's: normalised by it, every magnitude
+/// would shrink and κs would ghost too little away).
+pub fn context_on_bricked_data_normalises_by_the_levels_gradients(gpu: &mut Gpu) {
+    let ct = Arc::new(Phantom::Head.generate(128).expect("the head phantom"));
+    let source: Arc<dyn VoxelSource> = Arc::new(focal::volume::source::memory::MemorySource::new(ct.clone(), 32));
+    let look = Appearance {
+        context: focal::context::ContextParams { kappa_t: 2.0, kappa_s: 0.6, ..Default::default() },
+        ..Appearance::new(Mode::Context, presets::builtin("ct_skin_bone").expect("a built-in preset"))
+    };
+    let centre = ct.grid.center();
+    let extent = ct.grid.extent().max_element();
+    let eye = centre + Vec3::new(-0.5, -0.8, 0.3).normalize() * 2.0 * extent;
+    let camera = FocalCamera::look_at(eye, centre, Vec3::Z, FocalProjection::Orthographic { height: 0.9 * extent });
+    let bricked = show_bricked(gpu, &source, &look, &camera, true);
+    let status = gpu.off.world_mut().resource::<StreamStatus>().counts();
+    assert_eq!(status.finest_wanted, Some(0), "{status:?}");
+    let coarse_max = level(source.as_ref(), 1).gradient_max();
+    println!("    largest gradient: level 0 {:.4}, coarse level {coarse_max:.4}", ct.gradient_max());
+    let ratio = coarse_max.max(ct.gradient_max()) / coarse_max.min(ct.gradient_max());
+    assert!(ratio > 1.3, "the levels' gradients hardly differ (×{ratio:.2}): the test shows nothing");
+    let memory = gpu.show(ct, look, &camera);
+    assert_matches("bricked_context_noisy", &bricked, &memory);
+}
