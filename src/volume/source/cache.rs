@@ -210,9 +210,10 @@ impl BrickCache {
                 // which would then wait on the lock this job holds (a deadlock that hung
                 // the bricked renders).
                 let result = result.map(|block| {
-                    let faults = block.faults.iter().any(|f| f.kind != super::FaultKind::Absent).then(|| {
-                        format!("{}: {}", source.info().location(), super::level::summarize(&block.faults).unwrap_or_default())
-                    });
+                    let faults =
+                        block.faults.iter().any(|f| f.kind != super::FaultKind::Absent).then(|| {
+                            format!("{}: {}", source.info().location(), super::level::summarize(&block.faults).unwrap_or_default())
+                        });
                     (faults, Arc::new(BrickData::new(layout, block)))
                 });
                 let mut s = lock(&state);
@@ -327,8 +328,7 @@ mod tests {
         // (It took a few rounds to hang on two cores; without the fix the test hangs,
         // as the lock is held, rather than failing.)
         let layout = BrickLayout::new(32, 1);
-        let keys: Vec<BrickKey> =
-            (0..8u32 * 8 * 8).map(|i| BrickKey::new(0, UVec3::new(i % 8, i / 8 % 8, i / 64))).collect();
+        let keys: Vec<BrickKey> = (0..8u32 * 8 * 8).map(|i| BrickKey::new(0, UVec3::new(i % 8, i / 8 % 8, i / 64))).collect();
         for _ in 0..20 {
             let c = BrickCache::new(source(), layout, 1 << 30);
             c.request(&keys);
