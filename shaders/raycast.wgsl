@@ -31,12 +31,13 @@
 // loops that some lane never leaves; the comments below say where that shaped the code.
 
 #import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput
-#import focal::types::{Region, MODE_TWO_LEVEL, MODE_MIP, MODE_MIN_IP, MODE_X_RAY, MODE_ISO, REGION_LABELS, REGION_OCCUPANCY, VIEW_JITTER, VIEW_SKIP_EMPTY, VIEW_EARLY_TERMINATION, VIEW_DEBUG_RAYS, EARLY_TERMINATION, MAX_RAY_REGIONS, REGION_CLUSTER}
+#import focal::types::{Region, MODE_TWO_LEVEL, MODE_MIP, MODE_MIN_IP, MODE_X_RAY, MODE_ISO, REGION_LABELS, REGION_OCCUPANCY, VIEW_JITTER, VIEW_SKIP_EMPTY, VIEW_EARLY_TERMINATION, VIEW_DEBUG_RAYS, VIEW_DEBUG_COUNTS, EARLY_TERMINATION, MAX_RAY_REGIONS, REGION_CLUSTER}
 #import focal::bindings::{settings, scene, regions, depth_texture}
 #import focal::camera::{Ray, pixel_ray, scene_depth_t, jitter}
 #import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod}
 #import focal::regions::{region_interval, hole_interval, meets_sphere, pick_region, to_voxel, dir_to_voxel, world_step}
-#import focal::sampling::{trilinear, brick_occupied, brick_range, at_full_resolution}
+#import focal::sampling::{trilinear, brick_occupied, brick_range, at_full_resolution, count_sample, ray_sample_count}
+#import focal::bricked::page_lookup_count
 #import focal::selection::{region_weight, set_weight, pick_weight, set_companion, no_companion}
 #import focal::samples::{is_projection, dvr_sample, is_dvr_like, iso_hit, emit_projection}
 #import focal::segments::{DONE, HAS_PREV, PAIRABLE, CLOSES, Segment, segment_t, segment_point, past_brick, past_empty_bricks, past_empty_pair, cut_intervals, compact_intervals, leaves}
@@ -124,6 +125,9 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #endif
                 if n > first {
                     var ws = world_step(regions[i], ray.dir);
+                    // (Opacity correction per world length: a finer level's shorter
+                    // steps each take less, Volume::opacity_reference.)
+                    let factor = regions[i].native_step / (ws * regions[i].reference_length);
 #ifdef HAS_BRICKED
                     // A bricked region steps at the level its footprint asks for.
                     if regions[i].bricked.x != 0u {
@@ -131,7 +135,6 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                     }
 #endif
                     step = min(step, ws);
-                    let factor = regions[i].native_step / (ws * regions[i].reference_length);
                     let mode = regions[i].mode;
                     var kind = select(0u, CLOSES, is_projection(mode) || mode == MODE_TWO_LEVEL);
                     kind |= select(0u, PAIRABLE, is_dvr_like(mode, regions[i].flags));
@@ -308,6 +311,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                             continue;
                         }
                     }
+                    count_sample();
                     let v = trilinear(r, q);
                     mx = max(mx, v);
                     mn = min(mn, v);
@@ -335,6 +339,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                         break;
                     }
                     let tk = segment_t(g, kk);
+                    count_sample();
                     let v = trilinear(r, segment_point(g, kk)) - r.iso;
                     if has && ((vp < 0.0) != (v < 0.0)) {
                         acc = iso_hit(r, ray, tp, vp, tk, acc);
@@ -478,6 +483,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #endif
 #ifdef HAS_PROJECTION
             if is_projection(r.mode) {
+                count_sample();
                 let v = trilinear(r, q);
                 vmax[s] = max(vmax[s], v);
                 vmin[s] = min(vmin[s], v);
@@ -490,6 +496,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #endif
 #ifdef HAS_ISO
             if r.mode == MODE_ISO && (r.flags & REGION_LABELS) == 0u {
+                count_sample();
                 let v = trilinear(r, q) - r.iso;
                 if (state[s] & HAS_PREV) != 0u && ((prev_v[s] < 0.0) != (v < 0.0)) {
                     acc = iso_hit(r, ray, prev_t[s], prev_v[s], t, acc);
@@ -532,5 +539,19 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
         }
 #endif
     }
+    if (settings.flags & VIEW_DEBUG_COUNTS) != 0u {
+        return debug_counts();
+    }
     return acc;
+}
+
+// The ray's counts as render::counts decodes them: samples in red (low byte) and green
+// (high byte), page look-ups per sample ×32 in blue, each byte n written as the linear
+// value whose sRGB code is n (the target is sRGB), opaque over the black clear.
+fn debug_counts() -> vec4<f32> {
+    let n = min(ray_sample_count(), 65535u);
+    let per = min(u32(round(f32(page_lookup_count()) * 32.0 / f32(max(n, 1u)))), 255u);
+    let bytes = vec3<f32>(vec3<u32>(n & 255u, n >> 8u, per)) / 255.0;
+    let linear = select(pow((bytes + 0.055) / 1.055, vec3(2.4)), bytes / 12.92, bytes <= vec3(0.04045));
+    return vec4(linear, 1.0);
 }

@@ -225,6 +225,18 @@ fn axis_aligned_mip_is_the_voxel_maximum(gpu: &mut Gpu) {
     // Samples sit exactly on voxel centres, where hardware weights are 0 or 1: only the
     // 8-bit rounding of the output remains.
     assert!(worst <= 1, "MIP differs from the voxel maximum by {worst} levels");
+    // The per-ray counts (render::counts): every ray crosses the 20 slices at one
+    // sample a voxel (without brick skipping), and a volume in memory has no page table.
+    gpu.off.set_view(VolumeView { jitter: false, skip_empty: false, ..Default::default() });
+    let counts = focal::render::counts::decode(&gpu.off.capture_counts().unwrap_or_else(|e| panic!("{e}")));
+    gpu.off.set_view(VolumeView { jitter: false, ..Default::default() });
+    println!("    counts: {counts:?}");
+    assert_eq!((counts.rays, counts.samples, counts.most), ((SIZE * SIZE) as u64, (SIZE * SIZE * dims.z) as u64, dims.z));
+    assert_eq!(counts.lookups, 0.0);
+    // With skipping, bricks that cannot raise a ray's maximum are jumped over.
+    let skipped = focal::render::counts::decode(&gpu.off.capture_counts().unwrap_or_else(|e| panic!("{e}")));
+    println!("    counts with skipping: {skipped:?}");
+    assert!(skipped.samples < counts.samples, "{skipped:?}");
 }
 
 fn skipping_and_termination_keep_the_image(gpu: &mut Gpu) {

@@ -307,3 +307,40 @@ fn label_volumes_render_with_their_colours() {
     assert!(img.alpha[14 * 32 + 16] > 0.99 && c.x > 0.5 && c.y > 0.5, "{c}");
     assert_eq!(img.alpha[0], 0.0);
 }
+
+/// Opacity per millimetre is the full data's at every level of a pyramid
+/// (`Volume::opacity_reference`): a uniform slab 16 mm thick seen through, at constant
+/// opacity α = 0.05, accumulates 1 − (1 − α)^(D/ℓ) with ℓ the level-0 voxel (1 mm) —
+/// 0.5599 — whether drawn from level 0 or from level 1 (2 mm voxels). Had level 1 kept
+/// its own voxel as ℓ, it would accumulate 1 − 0.95⁸ = 0.3366.
+#[test]
+fn every_level_of_a_pyramid_is_as_opaque_per_millimetre_as_level_0() {
+    use focal::volume::source::VoxelSource;
+    use focal::volume::source::level::read_level;
+    use focal::volume::source::memory::MemorySource;
+    let dims = UVec3::new(16, 16, 16);
+    let v =
+        Volume::new("slab", Grid::centered(dims, Vec3::ONE), Voxels::U8(vec![100; 16 * 16 * 16]), ValueMap::IDENTITY, Source::default())
+            .unwrap();
+    let source = MemorySource::new(Arc::new(v), 8);
+    assert!(source.info().levels.len() >= 2);
+    let tf = TransferFunction {
+        name: "constant".into(),
+        space: ValueSpace::Relative,
+        units: None,
+        color: vec![ColorPoint(0.0, [1.0; 3])],
+        opacity: vec![OpacityPoint(0.0, 0.05)],
+        lambda_t: vec![],
+        lambda_s: vec![],
+    };
+    let want = 1.0 - 0.95f32.powf(16.0);
+    for level in [0, 1] {
+        let (volume, _) = read_level(&source, level, &|_| {}).unwrap();
+        assert_eq!(volume.opacity_reference(), 1.0);
+        let mut a = Appearance::new(Mode::Dvr, tf.clone());
+        a.shading.enabled = false;
+        let img = render(&RenderScene::single(Arc::new(volume), a), &top_camera(dims), 8, 8).unwrap();
+        let centre = img.alpha[(4 * 8 + 4) as usize];
+        assert!((centre - want).abs() < 0.01, "level {level}: opacity {centre} vs {want}");
+    }
+}

@@ -82,8 +82,16 @@ fn brick_count(dims: vec3<u32>, size: u32) -> vec3<u32> {
     return vec3<u32>(ceil(vec3<f32>(dims) / f32(size)));
 }
 
+// Page look-ups of this ray (VIEW_DEBUG_COUNTS).
+var<private> page_lookups: u32 = 0u;
+
+fn page_lookup_count() -> u32 {
+    return page_lookups;
+}
+
 // Looks q0 (level-0 index) up in r's page table.
 fn bricked_locate(r: Region, q0: vec3<f32>) {
+    page_lookups += 1u;
     let tree = pages[PAGE_HEADER + r.bricked.x - 1u];
     let size = r.bricked.y;
     let d0 = r.bricked_dims.xyz;

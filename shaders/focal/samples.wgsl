@@ -9,7 +9,7 @@
 #import focal::bindings::{settings, scene}
 #import focal::camera::Ray
 #import focal::regions::to_voxel
-#import focal::sampling::{trilinear, trilinear_with_doi, nearest_code, index_gradient, gradient_norm}
+#import focal::sampling::{trilinear, trilinear_with_doi, nearest_code, index_gradient, gradient_norm, count_sample}
 #import focal::transfer::{classify, classify_label, classify_lambda, correct_opacity, filtered_table}
 #import focal::shading::{shade, shade_with, blinn_phong}
 #import focal::context::{context_opacity, eye_distance}
@@ -44,6 +44,7 @@ fn value_at(r: Region, q: vec3<f32>, vd: vec2<f32>) -> f32 {
 // t, composited under acc, weighted by the current selection weight. The gradient is
 // fetched once for shading and modulation.
 fn dvr_sample(r: Region, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
+    count_sample();
     var rgba: vec4<f32>;
     var v = 0.0;
     // The value and the selection's sample, in one fetch with DOI_CHANNEL (labels or not).

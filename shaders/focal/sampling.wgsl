@@ -9,6 +9,18 @@
 #import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy, lut_atlas, brick_cache}
 #import focal::bricked::{is_bricked, level_zero, bricked_locate, bricked_texel, bricked_uvw, bricked_box_exit, box_exit, bricked_step_factor, sub_block_visible, sub_block_exit, bricked_gradient, bricked_gradient_max, bc_kind, bc_code, BRICKED_TEXEL, BRICKED_EMPTY}
 
+// The ray's samples taken (sample positions marched, not fetches) and page look-ups of
+// bricked volumes, shown with VIEW_DEBUG_COUNTS (render::counts; one add each).
+var<private> ray_samples: u32 = 0u;
+
+fn count_sample() {
+    ray_samples += 1u;
+}
+
+fn ray_sample_count() -> u32 {
+    return ray_samples;
+}
+
 // Mip level the samples come from: set per sample under lenses with anti-aliasing
 // (focal::lens::update_lod), 0 otherwise (reference: PreparedRegion::sample).
 var<private> sample_lod: f32 = 0.0;

@@ -8,7 +8,7 @@
 #import focal::bindings::{scene, regions}
 #import focal::camera::Ray
 #import focal::regions::to_voxel
-#import focal::sampling::{lut_texel, trilinear, nearest_code}
+#import focal::sampling::{lut_texel, trilinear, nearest_code, count_sample}
 #import focal::transfer::classify
 #import focal::compositing::composite
 #import focal::segments::{DONE, HAS_PREV}
@@ -85,6 +85,7 @@ fn end_segment(r: Region, part: Region, open: ptr<function, Open>, acc: vec4<f32
 // `labels` is r's label record; `part` holds the record of the open segment's part
 // (loaded here when the part changes, so a segment reads it once).
 fn two_level_sample(r: Region, labels: Region, part: ptr<function, Region>, open: ptr<function, Open>, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
+    count_sample();
     let v = trilinear(r, q);
     let k = part_of(r, labels, ray.origin + ray.dir * t, v);
     var out = acc;

@@ -112,6 +112,9 @@ const VIEW_SKIP_EMPTY: u32 = 2u;
 const VIEW_EARLY_TERMINATION: u32 = 4u;
 const VIEW_DEBUG_RAYS: u32 = 8u;
 const VIEW_LENS_ANTIALIAS: u32 = 16u;
+// Output the ray's sample and page look-up counts instead of its colour
+// (render::counts decodes them).
+const VIEW_DEBUG_COUNTS: u32 = 32u;
 
 // Accumulated opacity at which a ray stops (reference: trace::EARLY_TERMINATION).
 const EARLY_TERMINATION: f32 = 0.99;

@@ -16,6 +16,9 @@ pub struct VolumeView {
     pub early_termination: bool,
     /// Show ray directions instead of the volumes (tests of ray generation).
     pub debug_rays: bool,
+    /// Show each ray's sample and page look-up counts instead of the volumes
+    /// (`render::counts`: where the time of a frame goes).
+    pub debug_counts: bool,
     /// Under lenses, sample compressed areas from the mip chain (`lens::antialias`).
     pub lens_antialias: bool,
     /// Feature lenses find their silhouettes in compute passes (else on the CPU).
@@ -33,6 +36,7 @@ impl Default for VolumeView {
             skip_empty: true,
             early_termination: true,
             debug_rays: false,
+            debug_counts: false,
             lens_antialias: true,
             gpu_silhouettes: true,
             frame: 0,

@@ -49,7 +49,7 @@ pub struct PreparedRegion<'a> {
     pub shading: Shading,
     /// Step length in the volume's own millimetres.
     pub native_step: f32,
-    /// Reference length of transfer-function opacities (smallest voxel spacing).
+    /// Reference length of transfer-function opacities (`Volume::opacity_reference`).
     pub reference_length: f32,
     /// World→voxel linear part transposed: turns voxel-index gradients into world ones.
     pub normal_matrix: Mat3,
@@ -149,7 +149,7 @@ impl<'a> PreparedRegion<'a> {
         let occupancy = appearance.brick_occupancy(volume).map(|occ| (volume.bricks(), occ));
         let a = Mat3::from(region.world_to_voxel.matrix3);
         let index_to_native = volume.grid.direction * Mat3::from_diagonal(volume.grid.spacing);
-        let reference_length = volume.grid.min_spacing();
+        let reference_length = volume.opacity_reference();
         PreparedRegion {
             region,
             volume,
@@ -157,7 +157,7 @@ impl<'a> PreparedRegion<'a> {
             lookup,
             mode,
             shading: appearance.shading,
-            native_step: appearance.step.max(0.01) * reference_length,
+            native_step: appearance.step.max(0.01) * volume.grid.min_spacing(),
             reference_length,
             normal_matrix: a.transpose(),
             to_native: index_to_native * a,

@@ -34,6 +34,9 @@ impl ExtractComponent for VolumeView {
         if v.debug_rays {
             flags |= view_flags::DEBUG_RAYS;
         }
+        if v.debug_counts {
+            flags |= view_flags::DEBUG_COUNTS;
+        }
         if v.lens_antialias {
             flags |= view_flags::LENS_ANTIALIAS;
         }

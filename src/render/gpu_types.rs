@@ -116,6 +116,8 @@ pub mod view_flags {
     pub const DEBUG_RAYS: u32 = 8;
     /// Sample compressed areas under lenses from the mip chain.
     pub const LENS_ANTIALIAS: u32 = 16;
+    /// Output each pixel's sample and page look-up counts (`render::counts`).
+    pub const DEBUG_COUNTS: u32 = 32;
 }
 
 /// One region, with everything the shader needs about its volume and appearance.

@@ -214,6 +214,25 @@ impl Offscreen {
         Err("the GPU produced no image".into())
     }
 
+    /// Renders the per-ray counts of the current view (`render::counts::decode` reads
+    /// them): the view's switches with `debug_counts` and a black background for one
+    /// capture, then as they were.
+    pub fn capture_counts(&mut self) -> Result<image::RgbaImage, String> {
+        let world = self.app.world_mut();
+        let view = world.get::<VolumeView>(self.camera).copied().unwrap_or_default();
+        let clear = world.get::<Camera>(self.camera).map(|c| c.clear_color.clone());
+        if let Some(mut cam) = world.get_mut::<Camera>(self.camera) {
+            cam.clear_color = Color::BLACK.into();
+        }
+        self.set_view(VolumeView { debug_counts: true, ..view });
+        let image = self.capture();
+        self.set_view(view);
+        if let (Some(clear), Some(mut cam)) = (clear, self.app.world_mut().get_mut::<Camera>(self.camera)) {
+            cam.clear_color = clear;
+        }
+        image
+    }
+
     /// Runs frames until the volumes are drawn once (whatever streaming has brought by
     /// then); the frames it took.
     pub fn first_frame(&mut self) -> Result<u32, String> {

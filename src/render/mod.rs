@@ -17,6 +17,7 @@
 //! business (datasets, windows, exploded parts), expressed as regions.
 
 pub mod bricked;
+pub mod counts;
 pub mod extract;
 pub mod feature_pass;
 pub mod gpu_types;

@@ -56,6 +56,9 @@ pub struct Volume {
     pub values: ValueMap,
     pub stats: ValueStats,
     pub source: Source,
+    /// Length (mm) that transfer-function opacities are given for; `None`: the
+    /// smallest voxel spacing ([`Volume::opacity_reference`]).
+    opacity_reference: Option<f32>,
     bricks: OnceLock<BrickGrid>,
     gradient_max: OnceLock<f32>,
     pyramid: OnceLock<Vec<pyramid::Level>>,
@@ -70,6 +73,7 @@ impl Clone for Volume {
             values: self.values.clone(),
             stats: self.stats.clone(),
             source: self.source.clone(),
+            opacity_reference: self.opacity_reference,
             bricks: self.bricks.clone(),
             gradient_max: self.gradient_max.clone(),
             pyramid: self.pyramid.clone(),
@@ -100,6 +104,7 @@ impl Volume {
             values,
             stats,
             source,
+            opacity_reference: None,
             bricks: OnceLock::new(),
             gradient_max: OnceLock::new(),
             pyramid: OnceLock::new(),
@@ -108,6 +113,23 @@ impl Volume {
 
     pub fn dims(&self) -> UVec3 {
         self.grid.dims
+    }
+
+    /// The length (mm) that transfer-function opacities hold for: a sample one such
+    /// length long keeps the table's opacity, others are corrected to their length
+    /// (`1 − (1 − α)^(Δ/ℓ)`). The smallest voxel spacing, except for a level of a
+    /// pyramid, which keeps its level 0's: every level, and a lens's native bricks
+    /// inside a coarser context, are then as opaque per millimetre as the full data.
+    pub fn opacity_reference(&self) -> f32 {
+        self.opacity_reference.unwrap_or_else(|| self.grid.min_spacing())
+    }
+
+    /// This volume with opacities given for `mm` ([`Volume::opacity_reference`]).
+    pub fn with_opacity_reference(mut self, mm: f32) -> Volume {
+        if mm.is_finite() && mm > 0.0 {
+            self.opacity_reference = Some(mm);
+        }
+        self
     }
 
     /// Code of voxel (i, j, k).

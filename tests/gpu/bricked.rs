@@ -6,7 +6,10 @@
 //! Tolerance as the other GPU tests (mean below 1 level, 99 % within 6). What may differ:
 //! the bricked dataset's box is that of its coarse level (level 2: 46 voxels of 4 mm
 //! for 181 of 1 mm, so up to 3 mm of repeated edge voxels on the far faces, which are
-//! background in ch2), and brick aprons are filtered exactly like whole textures.
+//! background in ch2; rays entering through those faces sample at another phase of the
+//! step), and brick aprons are filtered exactly like whole textures. Opacities hold per
+//! millimetre of level 0 at every level (`Volume::opacity_reference`), in memory and
+//! bricked alike.
 
 use super::*;
 use focal::lens::{Lens, systems::replace_lenses};
@@ -82,7 +85,11 @@ pub fn bricked_ch2_converges_to_the_chosen_level_in_memory(gpu: &mut Gpu) {
     let centre = source.info().levels[0].grid.center();
     // An orthographic view 200 mm high over 64 pixels: 3.1 mm a pixel everywhere, so
     // level 1 (2 mm voxels) throughout; the coarse level 2 has 4 mm voxels.
-    let eye = centre + Vec3::new(0.45, -0.85, 0.27).normalize() * 400.0;
+    // (From the octant of the boxes' common corner: every ray enters through a face the
+    // coarse level's box and level 1's share, so both march the same sample grid. Seen
+    // from the far octant, rays entering through the far faces (the coarse box is 2 mm
+    // longer there) sample at another phase: p99 7 levels on the sharp skin.)
+    let eye = centre + Vec3::new(-0.45, -0.85, -0.27).normalize() * 400.0;
     let camera = FocalCamera::look_at(eye, centre, Vec3::Z, FocalProjection::Orthographic { height: 200.0 });
     let bricked = show_bricked(gpu, &source, &appearance, &camera, true);
     let status = gpu.off.world_mut().resource::<StreamStatus>().counts();
@@ -107,11 +114,25 @@ pub fn bricked_ch2_converges_to_the_chosen_level_in_memory(gpu: &mut Gpu) {
     assert!(difference(&bricked_context, &bricked).0 > 1.0, "context-preserving rendering changed nothing");
 
     // A 4× magnifier over the middle: native voxels under it, level 1 around it.
+    let plain = {
+        show_bricked(gpu, &source, &appearance, &camera, true);
+        gpu.off.capture_counts().unwrap_or_else(|e| panic!("{e}"))
+    };
     let lens = Lens::magnifier(Vec2::ZERO, 0.5, 0.2, 4.0);
     replace_lenses(gpu.off.world_mut(), std::slice::from_ref(&lens));
     let magnified = show_bricked(gpu, &source, &appearance, &camera, true);
     let status = gpu.off.world_mut().resource::<StreamStatus>().counts();
     assert_eq!(status.finest_wanted, Some(0), "{status:?}");
+    // Rays under the focus step at level 0, twice as often as level 1's there without
+    // the lens (they see other voxels, so only about); every sample looks its brick up
+    // in the page table.
+    let lensed = gpu.off.capture_counts().unwrap_or_else(|e| panic!("{e}"));
+    let focus = |x: u32, y: u32| Vec2::new(x as f32 - 31.5, y as f32 - 31.5).length() < 12.0;
+    use focal::render::counts::{decode, decode_where};
+    let (before, after) = (decode_where(&plain, focus), decode_where(&lensed, focus));
+    println!("    samples a ray in the focus: {:.1} without the lens, {:.1} with it", before.per_ray(), after.per_ray());
+    assert!(after.per_ray() > 1.5 * before.per_ray(), "the lens's rays do not step finer: {after:?} vs {before:?}");
+    assert!(decode(&plain).lookups_per_sample() >= 1.0, "{:?}", decode(&plain));
     let native = gpu.show(level(source.as_ref(), 0), appearance.clone(), &camera);
     let blurred = gpu.show(level(source.as_ref(), 1), appearance.clone(), &camera);
     replace_lenses(gpu.off.world_mut(), &[]);
@@ -127,9 +148,8 @@ pub fn bricked_ch2_converges_to_the_chosen_level_in_memory(gpu: &mut Gpu) {
 /// Two-level rendering (arteries DVR, skull MIP, ventricles X-ray, calcifications iso,
 /// the rest DVR) of the 128³ head phantom's CT streamed from a pyramid in memory (coarse
 /// level 1, 64³), in a view that wants level 0 throughout (0.9 of the head across 64
-/// pixels: 1.8 voxels a pixel), against the CT in memory. (The rest is not
-/// context-preserving here: its gradient normalisation comes from the coarse level's
-/// largest gradient, far below the noisy full-resolution CT's; see the notes.)
+/// pixels: 1.8 voxels a pixel), against the CT in memory. (Context-preserving rendering
+/// on bricked data has its own test below.)
 pub fn two_level_on_bricked_data_matches_memory(gpu: &mut Gpu) {
     let (ct, look) = super::twolevel::segmented_head_at(128);
     let look = Appearance { mode: Mode::Dvr, ..look };

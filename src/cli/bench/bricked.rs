@@ -90,6 +90,13 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>) -> Result<(), String
     let centre = (lo + hi) * 0.5;
     let (ms, images) = bench.rounds(camera, centre, 2, true, |off, i| show(off, i == 1))?;
     let diff = super::harness::difference(&images[0], &images[1]);
+    bench.off.set_camera(&camera);
+    let ray_counts = [false, true].map(|bricked| {
+        show(&mut bench.off, bricked);
+        bench.off.capture_counts().map(|i| focal::render::counts::decode(&i))
+    });
+    let [memory_counts, bricked_counts] = ray_counts;
+    let (memory_counts, bricked_counts) = (memory_counts?, bricked_counts?);
     rows.push(row(
         "bricked",
         &format!("level {level} in memory"),
@@ -101,14 +108,20 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>) -> Result<(), String
             counts.wanted
         ),
     ));
-    rows.push(row(
-        "bricked",
-        "orbit, resident",
-        ms[1],
-        &format!("level {level} in memory"),
-        ms[0],
-        format!("goal ≤ ×2; pictures differ by at most {diff} levels"),
-    ));
+    rows.push(Row {
+        sample_ratio: Some(bricked_counts.samples as f64 / memory_counts.samples.max(1) as f64),
+        ..row(
+            "bricked",
+            "orbit, resident",
+            ms[1],
+            &format!("level {level} in memory"),
+            ms[0],
+            format!(
+                "goal ≤ ×2; pictures differ by at most {diff} levels; {:.1} page look-ups a sample",
+                bricked_counts.lookups_per_sample()
+            ),
+        )
+    });
     bench.save_images("bricked", &[first, images[1].clone()])?;
 
     // A 4× magnifier over the bricked view.
@@ -119,16 +132,31 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>) -> Result<(), String
         replace_lenses(off.world_mut(), if i == 1 { std::slice::from_ref(&lens) } else { &[] });
     })?;
     let finest = status.counts().finest_wanted;
+    let plain = focal::render::counts::decode(&bench.off.capture_counts()?);
+    replace_lenses(bench.off.world_mut(), std::slice::from_ref(&lens));
+    let lensed = focal::render::counts::decode(&bench.off.capture_counts()?);
     replace_lenses(bench.off.world_mut(), &[]);
     rows.push(row("bricked", "no lens", ms[0], "no lens", ms[0], "the bricked view above, still".into()));
-    rows.push(row(
-        "bricked",
-        "magnifier 4×",
-        ms[1],
-        "no lens",
-        ms[0],
-        format!("goal ≤ ×1.3; finest level wanted {}", finest.map_or("-".into(), |l| l.to_string())),
-    ));
+    // (The lens's rays step at the level of their magnified footprint, two levels finer
+    // under a 4× focus: at equal cost per sample the frame costs its sample ratio.)
+    rows.push(Row {
+        sample_ratio: Some(lensed.samples as f64 / plain.samples.max(1) as f64),
+        ..row(
+            "bricked",
+            "magnifier 4×",
+            ms[1],
+            "no lens",
+            ms[0],
+            format!(
+                "goal ≤ ×1.3; finest level wanted {}; samples per ray {:.0} → {:.0} (most {} → {})",
+                finest.map_or("-".into(), |l| l.to_string()),
+                plain.per_ray(),
+                lensed.per_ray(),
+                plain.most,
+                lensed.most
+            ),
+        )
+    });
     bench.save_images("bricked-magnifier", &images)?;
 
     // The first frame of 8192³.

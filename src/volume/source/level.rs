@@ -54,7 +54,9 @@ pub fn read_level(source: &dyn VoxelSource, level: usize, done: &(dyn Fn(u64) + 
     }
     let volume = Volume::new(info.name.clone(), l.grid.clone(), voxels, info.values.clone(), source_facts)
         .map_err(|e| SourceError::new(info.location(), e))?;
-    Ok((volume, faults))
+    // (Opacities hold for level 0's voxels at every level: Volume::opacity_reference.)
+    let finest = info.levels.first().map_or(l.grid.min_spacing(), |l0| l0.grid.min_spacing());
+    Ok((volume.with_opacity_reference(finest), faults))
 }
 
 /// The finest level of `source` within `max_bytes`, read whole, with the opening's
