@@ -219,6 +219,14 @@ impl Appearance {
     /// [`Segmentation::brick_occupancy`].
     /// The same look with every opacity times `scale` (in 0..1; an exploded part fading
     /// by the viewing force). Segmentations' objects keep theirs.
+    /// Whether the look (or an object of its segmentation) weighs samples by the
+    /// normalised gradient magnitude (gradient-modulated and context-preserving DVR),
+    /// which needs the volume's largest gradient.
+    pub fn uses_gradient_magnitude(&self) -> bool {
+        matches!(self.mode, Mode::GradientDvr | Mode::Context)
+            || self.segmentation.as_ref().is_some_and(|s| s.objects.iter().any(|o| o.appearance.uses_gradient_magnitude()))
+    }
+
     pub fn with_opacity_scaled(mut self, scale: f32) -> Appearance {
         if scale >= 1.0 {
             return self;

@@ -87,7 +87,8 @@ pub struct BrickedDataset {
     pub coarse_bricks: Arc<Vec<(BrickKey, Arc<BrickData>)>>,
     /// The largest gradient magnitude seen at each level `0 … C` (normalised units per
     /// voxel of the level): the largest over the bricks of that level drawn so far
-    /// (it only grows), the whole coarse level's at `C`. A volume in memory normalises
+    /// (it only grows), the whole coarse level's at `C`; taken only while a look of the
+    /// volume needs it (`Appearance::uses_gradient_magnitude`). A volume in memory normalises
     /// by the largest over the whole volume, which a pyramid too large to read cannot
     /// know; once the bricks of a view are in, the view's is at hand.
     pub gradient_max: Vec<f32>,
@@ -138,8 +139,7 @@ impl BrickedDataset {
         let levels = info.levels.clone();
         let coarse_bricks = Arc::new(bricks_of(&volume, coarse).map_err(|e| e.to_string())?);
         let cache = Arc::new(BrickCache::new(source, BRICK, cpu_bytes));
-        let mut gradient_max = vec![0.0; coarse + 1];
-        gradient_max[coarse] = coarse_bricks.iter().map(|(_, b)| b.gradient_max).fold(0.0, f32::max);
+        let gradient_max = vec![0.0; coarse + 1];
         Ok(Ok((BrickedDataset { cache, levels, coarse, coarse_bricks, gradient_max }, volume)))
     }
 
@@ -156,8 +156,9 @@ impl BrickedDataset {
     pub fn see_gradients<'a>(&mut self, bricks: impl IntoIterator<Item = (BrickKey, &'a BrickData)>) -> bool {
         let mut grew = false;
         for (k, b) in bricks {
-            if let Some(m) = self.gradient_max.get_mut(k.level as usize).filter(|m| **m < b.gradient_max) {
-                *m = b.gradient_max;
+            let g = b.gradient_max();
+            if let Some(m) = self.gradient_max.get_mut(k.level as usize).filter(|m| **m < g) {
+                *m = g;
                 grew = true;
             }
         }
@@ -376,7 +377,7 @@ mod tests {
         let v =
             Volume::new("noise", Grid::new(dims, Vec3::ONE), Voxels::U16(codes), ValueMap::IDENTITY, Source::default()).expect("volume");
         let source: Arc<dyn VoxelSource> = Arc::new(MemorySource::new(Arc::new(v), 16));
-        let Ok(Ok((bricked, coarse))) = BrickedDataset::open(source.clone(), 1 << 20) else { panic!("streamed") };
+        let Ok(Ok((mut bricked, coarse))) = BrickedDataset::open(source.clone(), 1 << 20) else { panic!("streamed") };
         // 75 × 45 × 35 voxels: the first level within 64³.
         assert_eq!((bricked.coarse, coarse.dims()), (1, UVec3::new(75, 45, 35)));
         assert_eq!(bricked.table_dims().len(), 2, "the page table covers levels 0 … C");
@@ -387,7 +388,11 @@ mod tests {
             assert!(data.voxels == block.voxels, "brick {k:?} differs from the source's");
             assert_eq!(data.range, crate::volume::source::brick::code_range(&block.voxels));
         }
-        // The coarse level's largest gradient, from its bricks, is the whole volume's.
+        // The coarse level's largest gradient, from its bricks, is the whole volume's
+        // (taken when a look needs it: none was computed at opening).
+        assert_eq!(bricked.gradient_max, vec![0.0, 0.0]);
+        let coarse_bricks = bricked.coarse_bricks.clone();
+        assert!(bricked.see_gradients(coarse_bricks.iter().map(|(k, d)| (*k, d.as_ref()))));
         let g = bricked.gradient_max[1];
         assert!((g - coarse.gradient_max()).abs() < 1e-6 && g > 0.0, "{g} vs {}", coarse.gradient_max());
         assert_eq!(bricked.gradient_max[0], 0.0, "no level-0 brick seen yet");
@@ -422,13 +427,13 @@ mod tests {
         let key = BrickKey::new(0, UVec3::new(1, 0, 0));
         let Ok(block) = BRICK.read(source.as_ref(), 0, key.coords()) else { panic!("brick") };
         let brick = BrickData::new(BRICK, block);
-        assert!((brick.gradient_max - expected).abs() < 1e-6, "{} vs {expected}", brick.gradient_max);
+        assert!((brick.gradient_max() - expected).abs() < 1e-6, "{} vs {expected}", brick.gradient_max());
         assert!(bricked.see_gradients([(key, &brick)]));
         assert!(!bricked.see_gradients([(key, &brick)]), "seen again: nothing grew");
         assert_eq!(bricked.gradient_norms()[0], expected);
         // A level's normalisation never shrinks (a flatter brick seen later keeps it).
         let flat = BrickData::new(BRICK, crate::volume::source::Block { voxels: Voxels::U16(vec![7; 36 * 36 * 36]), faults: Vec::new() });
-        assert_eq!(flat.gradient_max, 0.0);
+        assert_eq!(flat.gradient_max(), 0.0);
         assert!(!bricked.see_gradients([(BrickKey::new(0, UVec3::ZERO), &flat)]));
         assert_eq!(bricked.gradient_norms()[0], expected);
     }

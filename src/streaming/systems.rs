@@ -149,9 +149,12 @@ pub fn stream_bricks(
         for (k, faults) in bricked.cache.faulted() {
             warn!("{faults} (brick {:?} of level {} of {})", k.brick, k.level, dataset.volume.name);
         }
-        // (Written only when a level's largest gradient grew: the component's change
-        // ticks stay quiet otherwise.)
-        if bricked.bypass_change_detection().see_gradients(seen_gradients.iter().map(|(k, d)| (*k, d.as_ref()))) {
+        // Only looks that weigh by the gradient magnitude need each level's largest
+        // (loads compute it then; written only when one grew: the component's change
+        // ticks stay quiet otherwise).
+        let magnitudes = looks.iter().any(|a| a.uses_gradient_magnitude());
+        bricked.cache.want_gradients(magnitudes);
+        if magnitudes && bricked.bypass_change_detection().see_gradients(seen_gradients.iter().map(|(k, d)| (*k, d.as_ref()))) {
             bricked.set_changed();
         }
         volumes[v] = Some(BrickFrame {

@@ -132,6 +132,7 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>) -> Result<(), String
         replace_lenses(off.world_mut(), if i == 1 { std::slice::from_ref(&lens) } else { &[] });
     })?;
     let finest = status.counts().finest_wanted;
+    replace_lenses(bench.off.world_mut(), &[]);
     let plain = focal::render::counts::decode(&bench.off.capture_counts()?);
     replace_lenses(bench.off.world_mut(), std::slice::from_ref(&lens));
     let lensed = focal::render::counts::decode(&bench.off.capture_counts()?);
