@@ -220,7 +220,7 @@ impl Offscreen {
     pub fn capture_counts(&mut self) -> Result<image::RgbaImage, String> {
         let world = self.app.world_mut();
         let view = world.get::<VolumeView>(self.camera).copied().unwrap_or_default();
-        let clear = world.get::<Camera>(self.camera).map(|c| c.clear_color.clone());
+        let clear = world.get::<Camera>(self.camera).map(|c| c.clear_color);
         if let Some(mut cam) = world.get_mut::<Camera>(self.camera) {
             cam.clear_color = Color::BLACK.into();
         }

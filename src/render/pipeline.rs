@@ -92,6 +92,20 @@ impl SpecializedRenderPipeline for RaycastPipeline {
 #[derive(Component)]
 pub struct RaycastPipelineId(pub CachedRenderPipelineId);
 
+/// The per-view features of a view over a scene of `features`: lenses, and their
+/// anti-aliasing where the view asks for it and some region is in memory
+/// (anti-aliasing samples in-memory volumes' mip chains; a scene of bricked regions
+/// alone reads none, its rays take their level from their footprint instead, and the
+/// lens footprint per pixel cost the bench's 4× magnifier ×2.9 → ×1.9 for nothing,
+/// besides switching empty-space skipping off in the lens border).
+pub fn lens_features(features: u32, lenses: bool, antialias: bool) -> u32 {
+    match (lenses, antialias) {
+        (false, _) => 0,
+        (true, true) if features & features::BRICKED_ONLY == 0 => features::LENSES | features::LENS_ANTIALIAS,
+        (true, _) => features::LENSES,
+    }
+}
+
 pub fn prepare_pipelines(
     mut commands: Commands,
     cache: Res<PipelineCache>,
@@ -103,13 +117,23 @@ pub fn prepare_pipelines(
 ) {
     let features = super::bricked::mark::pipeline_features(scene.features, atlas.coarse_in_atlas);
     for (entity, target, settings) in &views {
-        let lenses = match (settings.lens_count > 0, settings.flags & super::gpu_types::view_flags::LENS_ANTIALIAS != 0) {
-            (false, _) => 0,
-            (true, false) => features::LENSES,
-            (true, true) => features::LENSES | features::LENS_ANTIALIAS,
-        };
+        let lenses = lens_features(features, settings.lens_count > 0, settings.flags & super::gpu_types::view_flags::LENS_ANTIALIAS != 0);
         let key = RaycastKey { format: target.main_texture_format(), features: features | lenses };
         let id = pipelines.specialize(&cache, &pipeline, key);
         commands.entity(entity).insert(RaycastPipelineId(id));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lens_antialiasing_only_where_a_region_is_in_memory() {
+        let (l, aa) = (features::LENSES, features::LENS_ANTIALIAS);
+        assert_eq!(lens_features(features::DVR, false, true), 0);
+        assert_eq!(lens_features(features::DVR, true, false), l);
+        assert_eq!(lens_features(features::DVR | features::BRICKED, true, true), l | aa);
+        assert_eq!(lens_features(features::DVR | features::BRICKED | features::BRICKED_ONLY, true, true), l);
     }
 }
