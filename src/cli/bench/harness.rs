@@ -9,6 +9,7 @@ use focal::dataset::{Dataset, VolumeView};
 use focal::lens::Lens;
 use focal::lens::systems::replace_lenses;
 use focal::region::{Appearance, View};
+use focal::render::counts::{RayCounts, decode};
 use focal::render::headless::Offscreen;
 use focal::volume::Volume;
 
@@ -18,8 +19,8 @@ pub(super) struct Row {
     pub(super) ms: f64,
     pub(super) baseline: String,
     pub(super) ratio: f64,
-    /// The picture's samples against the baseline's, where counted
-    /// ([`Bench::classified_samples`]).
+    /// The picture's samples against the baseline's, where counted ([`Bench::counts`]
+    /// on the GPU, or [`Bench::classified_samples`] by the CPU reference).
     pub(super) sample_ratio: Option<f64>,
     pub(super) note: String,
 }
@@ -30,6 +31,9 @@ pub(super) struct Bench {
     pub(super) save: Option<std::path::PathBuf>,
     /// The camera of the last [`Self::place`].
     pub(super) camera: Option<focal::region::Camera>,
+    /// The GPU's per-ray counts of each configuration of the last [`Self::rounds`]
+    /// (`focal::render::counts`), from one frame of each before the timing.
+    pub(super) counts: Vec<RayCounts>,
 }
 
 impl Bench {
@@ -129,11 +133,15 @@ impl Bench {
         mut set: impl FnMut(&mut Offscreen, usize),
     ) -> Result<(Vec<f64>, Vec<image::RgbaImage>), String> {
         let mut turn = 0u32;
-        // Every configuration once first (pipelines, atlases), and its picture.
+        // Every configuration once first (pipelines, atlases), its picture and its
+        // samples.
         let mut images = Vec::new();
+        self.counts.clear();
         for i in 0..count {
             set(&mut self.off, i);
             images.push(self.off.capture()?);
+            let counts = self.off.capture_counts()?;
+            self.counts.push(decode(&counts));
         }
         let mut times = vec![Vec::new(); count];
         for _ in 0..self.frames {
@@ -218,8 +226,19 @@ impl Row {
 }
 
 /// Rows of a group timed by [`Bench::interleaved`], against its first configuration.
-pub(super) fn push_group(rows: &mut Vec<Row>, group: &'static str, names: &[&str], ms: &[f64], base_note: &str, note: &str) {
+/// The rows of a group timed by [`Bench::rounds`], the first its baseline, each with its
+/// picture's GPU samples against the baseline's (`counts`: [`Bench::counts`]).
+pub(super) fn push_group(
+    rows: &mut Vec<Row>,
+    counts: &[RayCounts],
+    group: &'static str,
+    names: &[&str],
+    ms: &[f64],
+    base_note: &str,
+    note: &str,
+) {
     let base = names[0].to_string();
+    let base_samples = counts.first().map(|c| c.samples);
     for (i, (name, t)) in names.iter().zip(ms).enumerate() {
         let note = if i == 0 { base_note } else { note };
         rows.push(Row {
@@ -228,7 +247,7 @@ pub(super) fn push_group(rows: &mut Vec<Row>, group: &'static str, names: &[&str
             ms: *t,
             baseline: base.clone(),
             ratio: t / ms[0].max(1e-9),
-            sample_ratio: None,
+            sample_ratio: base_samples.zip(counts.get(i)).map(|(b, c)| c.samples as f64 / b.max(1) as f64),
             note: note.into(),
         });
     }

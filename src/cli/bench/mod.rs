@@ -114,7 +114,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         app.add_plugins(FocalPlugins);
     })?;
     eprintln!("GPU: {}  image {w}×{h}, {} frames per configuration", off.adapter_name(), args.frames);
-    let mut bench = Bench { off, frames: args.frames.max(1), save: args.save.clone(), camera: None };
+    let mut bench = Bench { off, frames: args.frames.max(1), save: args.save.clone(), camera: None, counts: Vec::new() };
     let still = VolumeView { jitter: false, ..Default::default() };
     let mut rows = Vec::new();
 
@@ -129,7 +129,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let configs = [("skipping on", vec![], still), ("skipping off", vec![], VolumeView { skip_empty: false, ..still })];
         let (ms, images) = bench.interleaved(Arc::new(head.labels.volume), a, &configs, false)?;
         let note = format!("image differs by at most {} levels", difference(&images[0], &images[1]));
-        push_group(&mut rows, "skipping", &names(&configs), &ms, "head phantom arteries (label volume)", &note);
+        push_group(&mut rows, &bench.counts, "skipping", &names(&configs), &ms, "head phantom arteries (label volume)", &note);
         bench.save_images("skipping", &images)?;
     }
     if all || args.termination {
@@ -138,7 +138,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let configs = [("termination on", vec![], still), ("termination off", vec![], VolumeView { early_termination: false, ..still })];
         let (ms, images) = bench.interleaved(ct, a, &configs, false)?;
         bench.save_images("termination", &images)?;
-        push_group(&mut rows, "termination", &names(&configs), &ms, "head phantom, CT skin + bone", "");
+        push_group(&mut rows, &bench.counts, "termination", &names(&configs), &ms, "head phantom, CT skin + bone", "");
     }
     if all || args.modes {
         let engine = Arc::new(Phantom::Engine.generate(args.resolution)?);
@@ -185,7 +185,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         ];
         let (ms, images) = bench.interleaved_appearances(engine, &appearances, still)?;
         let note = format!("κt 0 differs from DVR by at most {} levels; goal ≤ ×1.05", difference(&images[0], &images[1]));
-        push_group(&mut rows, "context", &names, &ms, "engine phantom", &note);
+        push_group(&mut rows, &bench.counts, "context", &names, &ms, "engine phantom", &note);
         bench.save_images("context", &images)?;
     }
 
@@ -221,7 +221,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let appearances = [rest.clone(), segmented(alike), segmented(objects)];
         let (ms, images) = bench.interleaved_appearances(ct, &appearances, still)?;
         let note = format!("objects alike differ from no objects by at most {} levels", difference(&images[0], &images[1]));
-        push_group(&mut rows, "twolevel", &names, &ms, "head phantom", &note);
+        push_group(&mut rows, &bench.counts, "twolevel", &names, &ms, "head phantom", &note);
         bench.save_images("twolevel", &images)?;
     }
 
@@ -267,7 +267,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         ];
         let (ms, images) = bench.interleaved(ct, a, &configs, false)?;
         bench.save_images("lenses", &images)?;
-        push_group(&mut rows, "lenses", &names(&configs), &ms, "head phantom, CT skin + bone", "goal ≤ ×1.10");
+        push_group(&mut rows, &bench.counts, "lenses", &names(&configs), &ms, "head phantom, CT skin + bone", "goal ≤ ×1.10");
 
         // The feature lens needs its silhouette again whenever the camera moves: timed
         // while orbiting, silhouettes on the GPU (compute passes) and on the CPU.
@@ -283,7 +283,15 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         ];
         let (ms, images) = bench.interleaved(Arc::new(head.labels.volume), labels, &configs, true)?;
         bench.save_images("feature-lens", &images)?;
-        push_group(&mut rows, "lenses", &names(&configs), &ms, "labelled head phantom", "silhouette every frame; goal ≤ ×1.25");
+        push_group(
+            &mut rows,
+            &bench.counts,
+            "lenses",
+            &names(&configs),
+            &ms,
+            "labelled head phantom",
+            "silhouette every frame; goal ≤ ×1.25",
+        );
         replace_lenses(bench.off.world_mut(), &[]);
     }
 

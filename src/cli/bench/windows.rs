@@ -150,6 +150,6 @@ pub fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> Result<
         difference(&images[0], &images[3]),
         difference(&images[0], &images[6])
     );
-    push_group(rows, "windows", &names, &ms, "head phantom", &note);
+    push_group(rows, &bench.counts, "windows", &names, &ms, "head phantom", &note);
     Ok(())
 }
