@@ -20,6 +20,8 @@ const PROFILE_LINEAR: u32 = 1u;
 const SAMPLING_TABLE: u32 = 64u;
 // Floats before a silhouette's distances: centroid, equivalent radius, in view (feature.rs).
 const FIELD_HEADER: u32 = 4u;
+// Mip levels below this are level 0 (lens::antialias::LEVEL_DEAD_ZONE).
+const LEVEL_DEAD_ZONE: f32 = 0.00390625;
 
 fn view_aspect() -> f32 {
     return view.viewport.z / view.viewport.w;
@@ -340,7 +342,9 @@ fn lod_at(t: f32) -> f32 {
     if plain <= 0.0 {
         return 3.0;
     }
-    return clamp(log2(lensed / plain), 0.0, 3.0);
+    // (Below a 256th of a level, none: antialias::LEVEL_DEAD_ZONE.)
+    let l = log2(lensed / plain);
+    return select(min(l, 3.0), 0.0, l < LEVEL_DEAD_ZONE);
 }
 
 // Restricts the footprint to the ray's interval [t0, t1]: the lensed extent is convex in

@@ -137,7 +137,7 @@ impl Footprint {
 
     /// Whether the level is 0 all over `[t0, t1]` (both ends suffice, see the module docs).
     pub fn level_free(&self, t0: f32, t1: f32) -> bool {
-        self.magnification(t0) >= 1.0 && self.magnification(t1) >= 1.0
+        self.level(t0, 1.0) == 0.0 && self.level(t1, 1.0) == 0.0
     }
 
     /// Mip level at parameter `t` (eq. 4), at most `max_level`.
@@ -146,9 +146,21 @@ impl Footprint {
     }
 }
 
-/// Equation 4: `L = max(0, log₂(1/mf))`, at most `max_level`.
+/// Levels below this are level 0 ([`level_for`]): rounding leaves a lens that compresses
+/// nothing (a ×1 magnifier, the flat middle of a border) with `mf` a hair under 1, and
+/// a level of 10⁻⁴ blends in the mip chain invisibly but made every sample a mip sample
+/// and switched empty-space skipping off: 41 % more samples in the bench's ×1 lens with
+/// anti-aliasing. A 1/256 level moves a sample by under 0.4 % of the levels' difference.
+pub const LEVEL_DEAD_ZONE: f32 = 1.0 / 256.0;
+
+/// Equation 4: `L = max(0, log₂(1/mf))`, at most `max_level`; 0 below
+/// [`LEVEL_DEAD_ZONE`].
 pub fn level_for(mf: f32, max_level: f32) -> f32 {
-    if mf.is_nan() || mf <= 0.0 { max_level } else { (-mf.log2()).clamp(0.0, max_level) }
+    if mf.is_nan() || mf <= 0.0 {
+        return max_level;
+    }
+    let l = -mf.log2();
+    if l < LEVEL_DEAD_ZONE { 0.0 } else { l.min(max_level) }
 }
 
 #[cfg(test)]
@@ -166,6 +178,9 @@ mod tests {
         assert!((level_for(0.25, 3.0) - 2.0).abs() < 1e-6);
         assert!((level_for(0.5f32.powf(1.5), 3.0) - 1.5).abs() < 1e-5);
         assert_eq!(level_for(0.01, 3.0), 3.0);
+        // Within the dead zone: log₂(1/0.999) = 0.0014 of a level is none; 0.99 is 0.0145.
+        assert_eq!(level_for(0.999, 3.0), 0.0);
+        assert!((level_for(0.99, 3.0) - 0.0145).abs() < 1e-4);
     }
 
     #[test]
