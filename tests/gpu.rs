@@ -356,7 +356,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 28] = [
+    let tests: [GpuTest; 29] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -370,6 +370,7 @@ fn main() {
         ("outside_the_lens_the_image_is_unchanged", lenses::outside_the_lens_the_image_is_unchanged),
         ("antialiasing_removes_moire_where_lenses_compress", lenses::antialiasing_removes_moire_where_lenses_compress),
         ("feature_lens_matches_the_reference", lenses::feature_lens_matches_the_reference),
+        ("a_lens_that_compresses_nothing_takes_no_more_samples", lenses::a_lens_that_compresses_nothing_takes_no_more_samples),
         ("context_matches_the_reference", context::context_matches_the_reference),
         ("kappa_t_zero_is_dvr_on_the_gpu", context::kappa_t_zero_is_dvr_on_the_gpu),
         ("clipping_matches_the_reference", clip::clipping_matches_the_reference),
