@@ -71,19 +71,25 @@ pub enum RegionSystems {
 
 /// Collects one region per visible dataset.
 pub fn collect_regions(
-    datasets: Query<(Entity, &Dataset, Option<&GpuVolume>, &GlobalTransform)>,
+    datasets: Query<(Entity, &Dataset, Option<&GpuVolume>, &GlobalTransform, Option<&crate::streaming::bricked::BrickedDataset>)>,
     light: Res<SceneLight>,
     mut out: ResMut<SceneRegions>,
 ) {
     let mut scene = RenderScene { light: light.0, ..Default::default() };
     let mut entities = Vec::new();
-    for (entity, d, gpu, transform) in &datasets {
+    for (entity, d, gpu, transform, bricked) in &datasets {
         if !d.visible {
             continue;
         }
         let volume = gpu.map(|g| g.volume.clone()).unwrap_or_else(|| d.volume.clone());
         let index = scene.volumes.len();
-        scene.regions.push(d.clip.region(&volume.grid, transform.affine(), index));
+        let mut region = d.clip.region(&volume.grid, transform.affine(), index);
+        // A bricked dataset's volume is its coarse level: its region is level 0's box.
+        if let Some(b) = bricked {
+            let (lo, hi) = b.index_box();
+            region = region.cut_to_index_box(lo, hi);
+        }
+        scene.regions.push(region);
         scene.volumes.push(volume);
         scene.appearances.push(d.appearance.clone());
         entities.push(entity);

@@ -143,6 +143,17 @@ impl BrickedDataset {
         Ok(Ok((BrickedDataset { cache, levels, coarse, coarse_bricks, gradient_max }, volume)))
     }
 
+    /// The box of level 0's voxel cells in the coarse volume's continuous voxel index
+    /// (`lo`, `hi`): the coarse level's own box reaches up to 2^C − 1 level-0 voxels
+    /// past it on the far faces (where its last voxels average fewer than 2^C), which
+    /// would draw the edge voxels repeated. `q₀ = (q_C + ½)·2^C − ½`, so level 0's
+    /// `[−½, n₀ − ½]` is `[−½, n₀/2^C − ½]`.
+    pub fn index_box(&self) -> (Vec3, Vec3) {
+        let s = (1u32 << self.coarse) as f32;
+        let n0 = self.levels.first().map_or(Vec3::ONE, |l| l.grid.dims.as_vec3());
+        (Vec3::splat(-0.5), n0 / s - 0.5)
+    }
+
     /// Voxel dims of the levels `0 … C` the page table covers.
     pub fn table_dims(&self) -> Vec<UVec3> {
         self.levels[..=self.coarse].iter().map(|l| l.grid.dims).collect()
@@ -368,6 +379,44 @@ mod tests {
         assert_eq!(f.level_at(Vec3::new(9.4, 1.0, 1.0)), Some(2));
         assert_eq!(frame(&[coarse[0]], &[]).level_at(Vec3::new(9.4, 1.0, 1.0)), None, "its coarse brick missing");
         assert_eq!(frame(&[], &[]).level_at(Vec3::ONE), None, "nothing drawn: no level");
+    }
+
+    #[test]
+    fn a_bricked_datasets_region_is_level_0s_box() {
+        use crate::dataset::{Dataset, SceneRegions};
+        // 71 voxels along x: level 1 has 36, whose box reaches half a level-1 voxel (one
+        // level-0 voxel) past level 0's.
+        let dims = UVec3::new(71, 40, 36);
+        let v = Volume::new("v", Grid::new(dims, Vec3::ONE), Voxels::U8(vec![9; 71 * 40 * 36]), ValueMap::IDENTITY, Source::default())
+            .expect("volume");
+        let Ok(Ok((bricked, coarse))) = BrickedDataset::open(Arc::new(MemorySource::new(Arc::new(v), 16)), 1 << 20) else {
+            panic!("streamed")
+        };
+        assert_eq!((bricked.coarse, coarse.dims().x), (1, 36));
+        assert_eq!(bricked.index_box(), (Vec3::splat(-0.5), Vec3::new(35.0, 19.5, 17.5)));
+        let mut app = App::new();
+        app.add_plugins((MinimalPlugins, TransformPlugin, crate::dataset::DatasetPlugin));
+        let coarse = Arc::new(coarse);
+        app.world_mut().spawn((
+            Dataset::new(
+                coarse.clone(),
+                crate::region::Appearance::new(
+                    crate::region::Mode::Dvr,
+                    crate::transfer::presets::builtin("grayscale_ramp").expect("a preset"),
+                ),
+            ),
+            Transform::default(),
+            bricked,
+        ));
+        app.update();
+        let scene = &app.world().resource::<SceneRegions>().scene;
+        let region = &scene.regions[0];
+        // Level 0's last voxel cell ends at x = 70.5 (its grid: voxel centres 0 … 70).
+        let index_to_world = coarse.grid.world_to_index().inverse();
+        let at = |q: Vec3| index_to_world.transform_point3(q);
+        assert!(region.contains(at(Vec3::new(34.9, 10.0, 10.0))));
+        assert!(!region.contains(at(Vec3::new(35.2, 10.0, 10.0))), "the coarse box's overhang is drawn");
+        assert!((at(Vec3::new(35.0, 0.0, 0.0)).x - 70.5).abs() < 1e-4);
     }
 
     #[test]

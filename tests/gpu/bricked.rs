@@ -4,10 +4,10 @@
 //! magnifier must show native voxels over a coarser context.
 //!
 //! Tolerance as the other GPU tests (mean below 1 level, 99 % within 6). What may differ:
-//! the bricked dataset's box is that of its coarse level (level 2: 46 voxels of 4 mm
-//! for 181 of 1 mm, so up to 3 mm of repeated edge voxels on the far faces, which are
-//! background in ch2; rays entering through those faces sample at another phase of the
-//! step), and brick aprons are filtered exactly like whole textures. Opacities hold per
+//! the bricked dataset's box is level 0's (181 voxels of 1 mm: `BrickedDataset::index_box`)
+//! and a level in memory has its own (level 1: 91 voxels of 2 mm, 1 mm longer on the far
+//! faces, background in ch2; rays entering through those faces sample at another phase
+//! of the step), and brick aprons are filtered exactly like whole textures. Opacities hold per
 //! millimetre of level 0 at every level (`Volume::opacity_reference`), in memory and
 //! bricked alike.
 
@@ -85,10 +85,11 @@ pub fn bricked_ch2_converges_to_the_chosen_level_in_memory(gpu: &mut Gpu) {
     let centre = source.info().levels[0].grid.center();
     // An orthographic view 200 mm high over 64 pixels: 3.1 mm a pixel everywhere, so
     // level 1 (2 mm voxels) throughout; the coarse level 2 has 4 mm voxels.
-    // (From the octant of the boxes' common corner: every ray enters through a face the
-    // coarse level's box and level 1's share, so both march the same sample grid. Seen
-    // from the far octant, rays entering through the far faces (the coarse box is 2 mm
-    // longer there) sample at another phase: p99 7 levels on the sharp skin.)
+    // (From the octant of the boxes' common corner: every ray enters through a face
+    // level 0's box and level 1's share, so both march the same sample grid. Seen from
+    // the far octant, rays entering through the far faces (level 1's box is 1 mm longer
+    // there) sample at another phase: p99 7 levels on the sharp skin when the bricked
+    // box was the coarse level's, 3 mm longer.)
     let eye = centre + Vec3::new(-0.45, -0.85, -0.27).normalize() * 400.0;
     let camera = FocalCamera::look_at(eye, centre, Vec3::Z, FocalProjection::Orthographic { height: 200.0 });
     let bricked = show_bricked(gpu, &source, &appearance, &camera, true);
