@@ -69,25 +69,32 @@ pub enum RegionSystems {
     Modify,
 }
 
-/// Collects one region per visible dataset.
+/// The part of a dataset volume's continuous voxel-index box that holds data, where it is
+/// less than the whole (a bricked dataset's volume is its pyramid's coarse level, whose
+/// box reaches past level 0's: `streaming::bricked::BrickedDataset::index_box`).
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct DataBox {
+    pub lo: Vec3,
+    pub hi: Vec3,
+}
+
+/// Collects one region per visible dataset (cut to its [`DataBox`]).
 pub fn collect_regions(
-    datasets: Query<(Entity, &Dataset, Option<&GpuVolume>, &GlobalTransform, Option<&crate::streaming::bricked::BrickedDataset>)>,
+    datasets: Query<(Entity, &Dataset, Option<&GpuVolume>, &GlobalTransform, Option<&DataBox>)>,
     light: Res<SceneLight>,
     mut out: ResMut<SceneRegions>,
 ) {
     let mut scene = RenderScene { light: light.0, ..Default::default() };
     let mut entities = Vec::new();
-    for (entity, d, gpu, transform, bricked) in &datasets {
+    for (entity, d, gpu, transform, data_box) in &datasets {
         if !d.visible {
             continue;
         }
         let volume = gpu.map(|g| g.volume.clone()).unwrap_or_else(|| d.volume.clone());
         let index = scene.volumes.len();
         let mut region = d.clip.region(&volume.grid, transform.affine(), index);
-        // A bricked dataset's volume is its coarse level: its region is level 0's box.
-        if let Some(b) = bricked {
-            let (lo, hi) = b.index_box();
-            region = region.cut_to_index_box(lo, hi);
+        if let Some(b) = data_box {
+            region = region.cut_to_index_box(b.lo, b.hi);
         }
         scene.regions.push(region);
         scene.volumes.push(volume);

@@ -395,7 +395,8 @@ mod tests {
         assert_eq!((bricked.coarse, coarse.dims().x), (1, 36));
         assert_eq!(bricked.index_box(), (Vec3::splat(-0.5), Vec3::new(35.0, 19.5, 17.5)));
         let mut app = App::new();
-        app.add_plugins((MinimalPlugins, TransformPlugin, crate::dataset::DatasetPlugin));
+        app.add_plugins((MinimalPlugins, TransformPlugin, crate::dataset::DatasetPlugin))
+            .add_systems(PostUpdate, crate::streaming::systems::data_boxes.before(crate::dataset::RegionSystems::Collect));
         let coarse = Arc::new(coarse);
         app.world_mut().spawn((
             Dataset::new(

@@ -24,6 +24,7 @@ impl Plugin for StreamingPlugin {
         app.init_resource::<bricked::StreamBudget>()
             .init_resource::<bricked::StreamStatus>()
             .init_resource::<bricked::BrickedScene>()
+            .add_systems(PostUpdate, systems::data_boxes.before(crate::dataset::RegionSystems::Collect))
             .add_systems(
                 PostUpdate,
                 systems::stream_bricks.after(crate::dataset::RegionSystems::Modify).after(crate::lens::systems::resolve_view_lenses),

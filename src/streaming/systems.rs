@@ -11,7 +11,7 @@ use glam::Affine3A;
 
 use super::bricked::{BrickFrame, BrickedDataset, BrickedScene, StreamBudget, StreamStatus};
 use super::select::{Magnified, Seen, ViewFrame, wanted};
-use crate::dataset::{Dataset, SceneRegions, VolumeView};
+use crate::dataset::{DataBox, Dataset, SceneRegions, VolumeView};
 use crate::lens::ViewLenses;
 use crate::lens::stack::Effect;
 use crate::region::appearance::CodeVisibility;
@@ -20,6 +20,14 @@ use crate::volume::Volume;
 use crate::volume::source::cache::BrickKey;
 use std::collections::HashMap;
 use std::sync::Arc;
+
+/// Gives each bricked dataset its [`DataBox`]: level 0's box, not its coarse volume's.
+pub fn data_boxes(mut commands: Commands, added: Query<(Entity, &BrickedDataset), Changed<BrickedDataset>>) {
+    for (e, b) in &added {
+        let (lo, hi) = b.index_box();
+        commands.entity(e).insert(DataBox { lo, hi });
+    }
+}
 
 /// The views of volume cameras this frame.
 pub fn view_frames(views: &Query<(&ViewLenses, &VolumeView)>) -> Vec<ViewFrame> {
