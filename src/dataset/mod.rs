@@ -78,12 +78,11 @@ pub struct DataBox {
     pub hi: Vec3,
 }
 
+/// What [`collect_regions`] reads of each dataset.
+type DatasetItems = (Entity, &'static Dataset, Option<&'static GpuVolume>, &'static GlobalTransform, Option<&'static DataBox>);
+
 /// Collects one region per visible dataset (cut to its [`DataBox`]).
-pub fn collect_regions(
-    datasets: Query<(Entity, &Dataset, Option<&GpuVolume>, &GlobalTransform, Option<&DataBox>)>,
-    light: Res<SceneLight>,
-    mut out: ResMut<SceneRegions>,
-) {
+pub fn collect_regions(datasets: Query<DatasetItems>, light: Res<SceneLight>, mut out: ResMut<SceneRegions>) {
     let mut scene = RenderScene { light: light.0, ..Default::default() };
     let mut entities = Vec::new();
     for (entity, d, gpu, transform, data_box) in &datasets {
