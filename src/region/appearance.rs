@@ -212,13 +212,6 @@ impl Appearance {
         }
     }
 
-    /// Which bricks of `volume` can contribute under this appearance, for the modes that
-    /// composite samples (DVR, gradient-modulated DVR, label volumes): a brick whose code
-    /// range maps only to zero opacity adds nothing. `None` for modes that look at every
-    /// sample (projections, iso-surfaces). Segmented volumes: see
-    /// [`Segmentation::brick_occupancy`].
-    /// The same look with every opacity times `scale` (in 0..1; an exploded part fading
-    /// by the viewing force). Segmentations' objects keep theirs.
     /// Whether the look (or an object of its segmentation) weighs samples by the
     /// normalised gradient magnitude (gradient-modulated and context-preserving DVR),
     /// which needs the volume's largest gradient.
@@ -227,6 +220,8 @@ impl Appearance {
             || self.segmentation.as_ref().is_some_and(|s| s.objects.iter().any(|o| o.appearance.uses_gradient_magnitude()))
     }
 
+    /// The same look with every opacity times `scale` (in 0..1; an exploded part fading
+    /// by the viewing force). Segmentations' objects keep theirs.
     pub fn with_opacity_scaled(mut self, scale: f32) -> Appearance {
         if scale >= 1.0 {
             return self;
@@ -242,6 +237,11 @@ impl Appearance {
         self
     }
 
+    /// Which bricks of `volume` can contribute under this appearance, for the modes that
+    /// composite samples (DVR, gradient-modulated DVR, label volumes): a brick whose code
+    /// range maps only to zero opacity adds nothing. `None` for modes that look at every
+    /// sample (projections, iso-surfaces). Segmented volumes: see
+    /// [`Segmentation::brick_occupancy`].
     pub fn brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {
         let occupancy = match &self.segmentation {
             Some(seg) => Some(seg.brick_occupancy(volume, self.own_brick_occupancy(volume))),

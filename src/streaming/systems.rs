@@ -127,11 +127,17 @@ pub fn stream_bricks(
         let looks: Vec<&Appearance> =
             scene.regions.iter().filter(|r| r.volume == v).filter_map(|r| scene.appearances.get(r.appearance)).collect();
         let tests = visibility.of(volume, &looks);
+        // Only looks that weigh by the gradient magnitude need each level's largest
+        // (loads compute it then).
+        let magnitudes = looks.iter().any(|a| a.uses_gradient_magnitude());
+        bricked.cache.want_gradients(magnitudes);
         let (mut drawn, mut empty, mut seen_gradients) = (Vec::new(), Vec::new(), Vec::new());
         // The coarse level's bricks (always at hand), then the streamed ones present.
         let coarse = bricked.coarse_bricks.iter().map(|(k, d)| (*k, d.clone()));
         for (k, data) in coarse.chain(keys.into_iter().filter_map(|(_, k)| bricked.cache.get(k).map(|d| (k, d)))) {
-            seen_gradients.push((k, data.clone()));
+            if magnitudes {
+                seen_gradients.push((k, data.clone()));
+            }
             let shows = |(lo, hi): (u16, u16)| tests.as_ref().is_none_or(|t| t.is_empty() || t.iter().any(|f| f(lo, hi)));
             let mask = if shows(data.range) {
                 data.sub_ranges.iter().enumerate().filter(|(_, r)| shows(**r)).fold(0u64, |m, (i, _)| m | 1 << i)
@@ -157,12 +163,9 @@ pub fn stream_bricks(
         for (k, faults) in bricked.cache.faulted() {
             warn!("{faults} (brick {:?} of level {} of {})", k.brick, k.level, dataset.volume.name);
         }
-        // Only looks that weigh by the gradient magnitude need each level's largest
-        // (loads compute it then; written only when one grew: the component's change
-        // ticks stay quiet otherwise).
-        let magnitudes = looks.iter().any(|a| a.uses_gradient_magnitude());
-        bricked.cache.want_gradients(magnitudes);
-        if magnitudes && bricked.bypass_change_detection().see_gradients(seen_gradients.iter().map(|(k, d)| (*k, d.as_ref()))) {
+        // (Written only when a level's largest gradient grew: the component's change
+        // ticks stay quiet otherwise.)
+        if bricked.bypass_change_detection().see_gradients(seen_gradients.iter().map(|(k, d)| (*k, d.as_ref()))) {
             bricked.set_changed();
         }
         volumes[v] = Some(BrickFrame {

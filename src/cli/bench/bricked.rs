@@ -26,6 +26,8 @@ use focal::volume::source::VoxelSource;
 use focal::volume::source::level::read_level;
 use focal::volume::source::procedural::ProceduralSource;
 
+use focal::render::counts::RayCounts;
+
 use super::harness::{Bench, Row};
 
 /// The look of the procedural ball: only the lattices' crests opaque (as the example).
@@ -48,6 +50,14 @@ fn clear(bench: &mut Bench) {
     let old: Vec<Entity> = world.query_filtered::<Entity, With<Dataset>>().iter(world).collect();
     for e in old {
         world.despawn(e);
+    }
+}
+
+/// The GPU counts of the two configurations of the last [`Bench::rounds`].
+fn counted(bench: &Bench) -> Result<(RayCounts, RayCounts), String> {
+    match bench.counts[..] {
+        [a, b] => Ok((a, b)),
+        _ => Err(format!("{} configurations counted, two timed", bench.counts.len())),
     }
 }
 
@@ -90,13 +100,7 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>) -> Result<(), String
     let centre = (lo + hi) * 0.5;
     let (ms, images) = bench.rounds(camera, centre, 2, true, |off, i| show(off, i == 1))?;
     let diff = super::harness::difference(&images[0], &images[1]);
-    bench.off.set_camera(&camera);
-    let ray_counts = [false, true].map(|bricked| {
-        show(&mut bench.off, bricked);
-        bench.off.capture_counts().map(|i| focal::render::counts::decode(&i))
-    });
-    let [memory_counts, bricked_counts] = ray_counts;
-    let (memory_counts, bricked_counts) = (memory_counts?, bricked_counts?);
+    let (memory_counts, bricked_counts) = counted(bench)?;
     rows.push(row(
         "bricked",
         &format!("level {level} in memory"),
@@ -132,10 +136,7 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>) -> Result<(), String
         replace_lenses(off.world_mut(), if i == 1 { std::slice::from_ref(&lens) } else { &[] });
     })?;
     let finest = status.counts().finest_wanted;
-    replace_lenses(bench.off.world_mut(), &[]);
-    let plain = focal::render::counts::decode(&bench.off.capture_counts()?);
-    replace_lenses(bench.off.world_mut(), std::slice::from_ref(&lens));
-    let lensed = focal::render::counts::decode(&bench.off.capture_counts()?);
+    let (plain, lensed) = counted(bench)?;
     replace_lenses(bench.off.world_mut(), &[]);
     rows.push(row("bricked", "no lens", ms[0], "no lens", ms[0], "the bricked view above, still".into()));
     // (The lens's rays step at the level of their magnified footprint, two levels finer

@@ -225,7 +225,6 @@ impl Row {
     }
 }
 
-/// Rows of a group timed by [`Bench::interleaved`], against its first configuration.
 /// The rows of a group timed by [`Bench::rounds`], the first its baseline, each with its
 /// picture's GPU samples against the baseline's (`counts`: [`Bench::counts`]).
 pub(super) fn push_group(

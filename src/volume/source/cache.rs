@@ -347,10 +347,10 @@ mod tests {
     #[test]
     fn many_loads_on_the_rayon_pool_all_finish() {
         // Every brick of a 256³ source at once, on the default (rayon) spawner: each
-        // load decodes with rayon work of its own (the largest gradient's), so a load that held the cache's lock
-        // while it waited for that work deadlocked here (a worker stole another load).
-        // (It took a few rounds to hang on two cores; without the fix the test hangs,
-        // as the lock is held, rather than failing.)
+        // load decodes with rayon work of its own (the largest gradient's), so a load
+        // that held the cache's lock while it waited for that work deadlocked here (a
+        // worker stole another load). (It took a few rounds to hang on two cores;
+        // without the fix the test hangs, as the lock is held, rather than failing.)
         let layout = BrickLayout::new(32, 1);
         let keys: Vec<BrickKey> = (0..8u32 * 8 * 8).map(|i| BrickKey::new(0, UVec3::new(i % 8, i / 8 % 8, i / 64))).collect();
         for _ in 0..20 {
