@@ -115,6 +115,8 @@ const VIEW_LENS_ANTIALIAS: u32 = 16u;
 // Output the ray's sample and page look-up counts instead of its colour
 // (render::counts decodes them).
 const VIEW_DEBUG_COUNTS: u32 = 32u;
+// Bricked regions under lenses step at the camera footprint's level.
+const VIEW_LENS_CONTEXT_STEPS: u32 = 64u;
 
 // Accumulated opacity at which a ray stops (reference: trace::EARLY_TERMINATION).
 const EARLY_TERMINATION: f32 = 0.99;

@@ -188,6 +188,7 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
             skip_empty: !args.no_skip,
             early_termination: !args.no_early_termination,
             lens_antialias: true,
+            lens_context_steps: false,
         },
         datasets: vec![DatasetSpec::of(source, appearance)],
         camera,

@@ -21,6 +21,11 @@ pub struct VolumeView {
     pub debug_counts: bool,
     /// Under lenses, sample compressed areas from the mip chain (`lens::antialias`).
     pub lens_antialias: bool,
+    /// Under lenses, bricked regions step along the ray at the camera's rate (the
+    /// context's) while sampling the finer bricks the lens asked for: a magnifier then
+    /// costs about what the view without it costs, native laterally, but a structure
+    /// thinner than the context's step along the ray may be missed (default off).
+    pub lens_context_steps: bool,
     /// Feature lenses find their silhouettes in compute passes (else on the CPU).
     pub gpu_silhouettes: bool,
     /// Seed of the jitter pattern.
@@ -38,6 +43,7 @@ impl Default for VolumeView {
             debug_rays: false,
             debug_counts: false,
             lens_antialias: true,
+            lens_context_steps: false,
             gpu_silhouettes: true,
             frame: 0,
             light: Light::Headlight,

@@ -40,6 +40,9 @@ impl ExtractComponent for VolumeView {
         if v.lens_antialias {
             flags |= view_flags::LENS_ANTIALIAS;
         }
+        if v.lens_context_steps {
+            flags |= view_flags::LENS_CONTEXT_STEPS;
+        }
         let light = match v.light {
             Light::Headlight => Vec4::ZERO,
             Light::Direction(d) => d.normalize_or_zero().extend(1.0),

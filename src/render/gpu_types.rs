@@ -118,6 +118,9 @@ pub mod view_flags {
     pub const LENS_ANTIALIAS: u32 = 16;
     /// Output each pixel's sample and page look-up counts (`render::counts`).
     pub const DEBUG_COUNTS: u32 = 32;
+    /// Bricked regions under lenses step at the camera footprint's level
+    /// (`VolumeView::lens_context_steps`).
+    pub const LENS_CONTEXT_STEPS: u32 = 64;
 }
 
 /// One region, with everything the shader needs about its volume and appearance.

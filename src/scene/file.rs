@@ -90,11 +90,15 @@ pub struct RenderingSpec {
     /// Under lenses, sample compressed areas from the volume's mip chain (eq. 4).
     #[serde(default = "yes")]
     pub lens_antialias: bool,
+    /// Bricked data under lenses steps along the ray at the context's rate
+    /// (`VolumeView::lens_context_steps`: faster, thin structures may be missed).
+    #[serde(default)]
+    pub lens_context_steps: bool,
 }
 
 impl Default for RenderingSpec {
     fn default() -> Self {
-        Self { jitter: true, skip_empty: true, early_termination: true, lens_antialias: true }
+        Self { jitter: true, skip_empty: true, early_termination: true, lens_antialias: true, lens_context_steps: false }
     }
 }
 

@@ -151,6 +151,7 @@ impl GpuRun {
             skip_empty: r.skip_empty,
             early_termination: r.early_termination,
             lens_antialias: r.lens_antialias,
+            lens_context_steps: r.lens_context_steps,
             ..Default::default()
         });
         self.off.set_background(scene.background());

@@ -452,6 +452,10 @@ fn rendering_panel(ui: &mut Ui, d: &mut Dataset, state: &mut AppState, light: &m
     ui.checkbox(&mut state.view.skip_empty, "skip empty space");
     ui.checkbox(&mut state.view.early_termination, "early ray termination");
     ui.checkbox(&mut state.view.lens_antialias, "anti-alias where lenses compress");
+    ui.checkbox(&mut state.view.lens_context_steps, "fast lenses on streamed data").on_hover_text(
+        "Under a lens, streamed data steps along the ray at the context's rate: native voxels across, \
+         about the cost of no lens, but structures thin along the ray may be missed",
+    );
 }
 
 fn camera_panel(ui: &mut Ui, orbit: &mut OrbitCamera, bounds: (Vec3, Vec3)) {

@@ -134,6 +134,20 @@ pub fn bricked_ch2_converges_to_the_chosen_level_in_memory(gpu: &mut Gpu) {
     println!("    samples a ray in the focus: {:.1} without the lens, {:.1} with it", before.per_ray(), after.per_ray());
     assert!(after.per_ray() > 1.5 * before.per_ray(), "the lens's rays do not step finer: {after:?} vs {before:?}");
     assert!(decode(&plain).lookups_per_sample() >= 1.0, "{:?}", decode(&plain));
+    // Stepping at the context's rate along the ray (VolumeView::lens_context_steps): the
+    // same rays through the same native bricks at level 1's step, half the samples of
+    // level 0's. (Not the counts of the view without the lens: its rays are others.)
+    gpu.off.set_view(VolumeView { jitter: false, lens_context_steps: true, ..Default::default() });
+    let fast_image = gpu.off.capture().unwrap_or_else(|e| panic!("{e}"));
+    let fast = decode_where(&gpu.off.capture_counts().unwrap_or_else(|e| panic!("{e}")), focus);
+    gpu.off.set_view(VolumeView { jitter: false, ..Default::default() });
+    println!("    samples a ray in the focus at the context's steps: {:.1}", fast.per_ray());
+    assert!(
+        (2.0 * fast.per_ray() - after.per_ray()).abs() < 0.15 * after.per_ray(),
+        "at the context's steps the lens's rays take {fast:?}, at their own {after:?}"
+    );
+    let (fast_mean, _, _) = difference(&fast_image, &magnified);
+    assert!(fast_mean > 0.0 && fast_mean < 4.0, "context steps against native steps: mean {fast_mean:.3}");
     let native = gpu.show(level(source.as_ref(), 0), appearance.clone(), &camera);
     let blurred = gpu.show(level(source.as_ref(), 1), appearance.clone(), &camera);
     replace_lenses(gpu.off.world_mut(), &[]);

@@ -5,7 +5,9 @@
 //!   is resident, against the same view of the level the view chose, whole in memory
 //!   (goal ≤ ×2: the page-table indirection's cost);
 //! - **magnifier**: a 4× magnifier over the bricked view (native bricks under it)
-//!   against the bricked view without it (goal ≤ ×1.3);
+//!   against the bricked view without it (goal ≤ ×1.3), and the same magnifier stepping
+//!   at the context's rate along the ray (`VolumeView::lens_context_steps`): what the
+//!   lens costs apart from its finer samples;
 //! - **first frame 8192³**: from opening the 8192³ procedural source (1 TiB of codes) to
 //!   its first drawn frame, the coarse level (goal under 1 s; the ratio is against 1 s);
 //! - **peak memory**: peak resident memory of `focal render procedural:1024` in a child
@@ -128,19 +130,25 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>) -> Result<(), String
     });
     bench.save_images("bricked", &[first, images[1].clone()])?;
 
-    // A 4× magnifier over the bricked view.
+    // A 4× magnifier over the bricked view, its rays stepping at their own footprint's
+    // level (native) and at the camera's (VolumeView::lens_context_steps).
     show(&mut bench.off, true);
     bench.off.set_camera(&camera);
     let lens = Lens::magnifier(Vec2::new(0.05, 0.0), 0.3, 0.15, 4.0);
-    let (ms, images) = bench.rounds(camera, centre, 2, false, |off, i| {
-        replace_lenses(off.world_mut(), if i == 1 { std::slice::from_ref(&lens) } else { &[] });
+    let (ms, images) = bench.rounds(camera, centre, 3, false, |off, i| {
+        replace_lenses(off.world_mut(), if i >= 1 { std::slice::from_ref(&lens) } else { &[] });
+        off.set_view(VolumeView { lens_context_steps: i == 2, ..still });
     })?;
     let finest = status.counts().finest_wanted;
-    let (plain, lensed) = counted(bench)?;
+    let [plain, lensed, fast] = bench.counts[..] else {
+        return Err(format!("{} configurations counted, three timed", bench.counts.len()));
+    };
     replace_lenses(bench.off.world_mut(), &[]);
+    bench.off.set_view(still);
     rows.push(row("bricked", "no lens", ms[0], "no lens", ms[0], "the bricked view above, still".into()));
     // (The lens's rays step at the level of their magnified footprint, two levels finer
     // under a 4× focus: at equal cost per sample the frame costs its sample ratio.)
+    let per_ray = |c: &RayCounts| format!("samples per ray {:.0} → {:.0} (most {} → {})", plain.per_ray(), c.per_ray(), plain.most, c.most);
     rows.push(Row {
         sample_ratio: Some(lensed.samples as f64 / plain.samples.max(1) as f64),
         ..row(
@@ -149,13 +157,21 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>) -> Result<(), String
             ms[1],
             "no lens",
             ms[0],
+            format!("goal ≤ ×1.3; finest level wanted {}; {}", finest.map_or("-".into(), |l| l.to_string()), per_ray(&lensed)),
+        )
+    });
+    let (diff, share) = (super::harness::difference(&images[1], &images[2]), super::harness::share_differing(&images[1], &images[2], 16));
+    rows.push(Row {
+        sample_ratio: Some(fast.samples as f64 / plain.samples.max(1) as f64),
+        ..row(
+            "bricked",
+            "magnifier 4×, context steps",
+            ms[2],
+            "no lens",
+            ms[0],
             format!(
-                "goal ≤ ×1.3; finest level wanted {}; samples per ray {:.0} → {:.0} (most {} → {})",
-                finest.map_or("-".into(), |l| l.to_string()),
-                plain.per_ray(),
-                lensed.per_ray(),
-                plain.most,
-                lensed.most
+                "the same native bricks stepped at the context's rate along the ray (the lens code's own cost); {}; differs from native steps by more than 16 levels in {share:.0} % of the drawn pixels (at most {diff})",
+                per_ray(&fast)
             ),
         )
     });

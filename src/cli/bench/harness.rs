@@ -256,3 +256,15 @@ pub(super) fn push_group(
 pub(super) fn difference(a: &image::RgbaImage, b: &image::RgbaImage) -> u8 {
     a.pixels().zip(b.pixels()).flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c]))).max().unwrap_or(0)
 }
+
+/// The share (%) of the pixels drawn in either picture (not black in both) where some
+/// channel differs by more than `levels`.
+pub(super) fn share_differing(a: &image::RgbaImage, b: &image::RgbaImage, levels: u8) -> f64 {
+    let drawn = |p: &image::Rgba<u8>| p.0[..3].iter().any(|&c| c > 0);
+    let (mut n, mut over) = (0usize, 0usize);
+    for (p, q) in a.pixels().zip(b.pixels()).filter(|(p, q)| drawn(p) || drawn(q)) {
+        n += 1;
+        over += usize::from((0..3).any(|c| p[c].abs_diff(q[c]) > levels));
+    }
+    100.0 * over as f64 / n.max(1) as f64
+}
