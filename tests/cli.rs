@@ -59,7 +59,7 @@ fn bench_explode_reports_table_1_as_percentages_of_the_plain_frame_rate() {
     // The paper's table 1, small: 1 and 2 parts, at rest and exploded, against the plain
     // ray caster in the same run (on the GPU: lavapipe where there is none).
     let out = focal()
-        .args(["bench", "--explode", "--parts", "1,2", "--frames", "1", "--size", "32x32", "--resolution", "32", "--json"])
+        .args(["bench", "--explode", "--parts", "1,2", "--frames", "2", "--size", "32x32", "--resolution", "32", "--json"])
         .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
         .output()
         .unwrap();
@@ -72,7 +72,10 @@ fn bench_explode_reports_table_1_as_percentages_of_the_plain_frame_rate() {
         assert_eq!(r["baseline"], "plain ray caster");
         let (ratio, percent) = (r["ratio"].as_f64().unwrap(), r["frame_rate_percent"].as_f64().unwrap());
         assert!(ratio > 0.0 && (percent * ratio - 100.0).abs() < 1e-6, "{r}");
+        // The spread of the per-round ratios beside the ratio.
+        assert!(r["ratio_spread"].as_f64().is_some_and(|s| s >= 0.0), "{r}");
     }
+    assert_eq!(rows[0]["ratio_spread"], 0.0);
     assert_eq!(rows[0]["frame_rate_percent"], 100.0);
     // Each picture's samples against the plain one's (CPU reference): the parts pushed
     // apart show their insides, so more of them.

@@ -64,7 +64,25 @@ fn counted(bench: &Bench) -> Result<(RayCounts, RayCounts), String> {
 }
 
 fn row(group: &'static str, config: &str, ms: f64, baseline: &str, base_ms: f64, note: String) -> Row {
-    Row { group, config: config.into(), ms, baseline: baseline.into(), ratio: ms / base_ms.max(1e-9), sample_ratio: None, note }
+    Row {
+        group,
+        config: config.into(),
+        ms,
+        baseline: baseline.into(),
+        ratio: ms / base_ms.max(1e-9),
+        sample_ratio: None,
+        spread: None,
+        note,
+    }
+}
+
+/// [`row`] for configuration `i` of the last [`Bench::rounds`]: its paired ratio and spread.
+fn paired_row(bench: &Bench, i: usize, config: &str, ms: &[f64], baseline: &str, note: String) -> Row {
+    let base = row("bricked", config, ms[i], baseline, ms[0], note);
+    match bench.paired.get(i) {
+        Some(p) => Row { ratio: p.ratio, spread: Some(p.spread), ..base },
+        None => base,
+    }
 }
 
 pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>) -> Result<(), String> {
@@ -116,12 +134,12 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>) -> Result<(), String
     ));
     rows.push(Row {
         sample_ratio: Some(bricked_counts.samples as f64 / memory_counts.samples.max(1) as f64),
-        ..row(
-            "bricked",
+        ..paired_row(
+            bench,
+            1,
             "orbit, resident",
-            ms[1],
+            &ms,
             &format!("level {level} in memory"),
-            ms[0],
             format!(
                 "goal ≤ ×2; pictures differ by at most {diff} levels; {:.1} page look-ups a sample",
                 bricked_counts.lookups_per_sample()
@@ -151,24 +169,24 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>) -> Result<(), String
     let per_ray = |c: &RayCounts| format!("samples per ray {:.0} → {:.0} (most {} → {})", plain.per_ray(), c.per_ray(), plain.most, c.most);
     rows.push(Row {
         sample_ratio: Some(lensed.samples as f64 / plain.samples.max(1) as f64),
-        ..row(
-            "bricked",
+        ..paired_row(
+            bench,
+            1,
             "magnifier 4×",
-            ms[1],
+            &ms,
             "no lens",
-            ms[0],
             format!("goal ≤ ×1.3; finest level wanted {}; {}", finest.map_or("-".into(), |l| l.to_string()), per_ray(&lensed)),
         )
     });
     let (diff, share) = (super::harness::difference(&images[1], &images[2]), super::harness::share_differing(&images[1], &images[2], 16));
     rows.push(Row {
         sample_ratio: Some(fast.samples as f64 / plain.samples.max(1) as f64),
-        ..row(
-            "bricked",
+        ..paired_row(
+            bench,
+            2,
             "magnifier 4×, context steps",
-            ms[2],
+            &ms,
             "no lens",
-            ms[0],
             format!(
                 "the same native bricks stepped at the context's rate along the ray (the lens code's own cost); {}; differs from native steps by more than 16 levels in {share:.0} % of the drawn pixels (at most {diff})",
                 per_ray(&fast)

@@ -102,7 +102,7 @@ pub fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32, only: &[us
     );
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
     let first = rows.len();
-    push_group(rows, &bench.counts, "explode", &names, &ms, "head phantom", &note);
+    push_group(rows, bench, "explode", &names, &ms, "head phantom", &note);
     // Each picture's samples against the plain one's: at equal cost per sample, the
     // frame rate cannot exceed 100 % / that ratio.
     for (row, n) in rows[first..].iter_mut().zip(&samples) {

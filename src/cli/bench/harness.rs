@@ -22,7 +22,36 @@ pub(super) struct Row {
     /// The picture's samples against the baseline's, where counted ([`Bench::counts`]
     /// on the GPU, or [`Bench::classified_samples`] by the CPU reference).
     pub(super) sample_ratio: Option<f64>,
+    /// Half the interquartile range of the ratio over the rounds (each round's frame
+    /// against the baseline's of the same round), where timed in rounds.
+    pub(super) spread: Option<f64>,
     pub(super) note: String,
+}
+
+/// A configuration's ratio against the first of its [`Bench::rounds`]: the median over
+/// the rounds of its frame time over the first configuration's in the same round, and
+/// half the interquartile range of those ratios.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Paired {
+    pub(super) ratio: f64,
+    pub(super) spread: f64,
+}
+
+impl Paired {
+    /// From the per-round ratios.
+    pub(super) fn of(mut ratios: Vec<f64>) -> Paired {
+        if ratios.is_empty() {
+            return Paired { ratio: f64::NAN, spread: f64::NAN };
+        }
+        ratios.sort_by(f64::total_cmp);
+        let q = |f: f64| {
+            // Linear interpolation between order statistics (numpy's default).
+            let x = f * (ratios.len() - 1) as f64;
+            let (i, t) = (x.floor() as usize, x.fract());
+            ratios[i] + (ratios[(i + 1).min(ratios.len() - 1)] - ratios[i]) * t
+        };
+        Paired { ratio: q(0.5), spread: 0.5 * (q(0.75) - q(0.25)) }
+    }
 }
 
 pub(super) struct Bench {
@@ -34,22 +63,11 @@ pub(super) struct Bench {
     /// The GPU's per-ray counts of each configuration of the last [`Self::rounds`]
     /// (`focal::render::counts`), from one frame of each before the timing.
     pub(super) counts: Vec<RayCounts>,
+    /// Each configuration's ratio against the first of the last [`Self::rounds`].
+    pub(super) paired: Vec<Paired>,
 }
 
 impl Bench {
-    pub(super) fn show(
-        &mut self,
-        volume: Arc<Volume>,
-        appearance: Appearance,
-        view: VolumeView,
-    ) -> Result<(f64, image::RgbaImage), String> {
-        self.place(volume, appearance);
-        self.off.set_view(view);
-        let image = self.off.capture()?;
-        let t = self.off.time_frames(self.frames);
-        Ok((t.as_secs_f64() * 1000.0, image))
-    }
-
     /// Shows `volume` alone, framed from the oblique view; the camera and the volume's
     /// centre.
     pub(super) fn place(&mut self, volume: Arc<Volume>, appearance: Appearance) -> (focal::region::Camera, Vec3) {
@@ -144,7 +162,8 @@ impl Bench {
             self.counts.push(decode(&counts));
         }
         let mut times = vec![Vec::new(); count];
-        for _ in 0..self.frames {
+        // One round untimed (caches, clocks), then the timed ones.
+        for round in 0..=self.frames {
             for (i, samples) in times.iter_mut().enumerate() {
                 set(&mut self.off, i);
                 // (An untimed frame first takes the switch.)
@@ -159,9 +178,12 @@ impl Bench {
                         });
                     }
                 });
-                samples.push(t.as_secs_f64() * 1000.0);
+                if round > 0 {
+                    samples.push(t.as_secs_f64() * 1000.0);
+                }
             }
         }
+        self.paired = times.iter().map(|v| Paired::of(v.iter().zip(&times[0]).map(|(t, base)| t / base.max(1e-9)).collect())).collect();
         if std::env::var_os("FOCAL_BENCH_SAMPLES").is_some() {
             for (i, v) in times.iter().enumerate() {
                 eprintln!("config {i}: {}", v.iter().map(|t| format!("{t:.0}")).collect::<Vec<_>>().join(" "));
@@ -226,18 +248,11 @@ impl Row {
 }
 
 /// The rows of a group timed by [`Bench::rounds`], the first its baseline, each with its
-/// picture's GPU samples against the baseline's (`counts`: [`Bench::counts`]).
-pub(super) fn push_group(
-    rows: &mut Vec<Row>,
-    counts: &[RayCounts],
-    group: &'static str,
-    names: &[&str],
-    ms: &[f64],
-    base_note: &str,
-    note: &str,
-) {
+/// paired ratio and spread ([`Bench::paired`]) and its picture's GPU samples against the
+/// baseline's ([`Bench::counts`]).
+pub(super) fn push_group(rows: &mut Vec<Row>, bench: &Bench, group: &'static str, names: &[&str], ms: &[f64], base_note: &str, note: &str) {
     let base = names[0].to_string();
-    let base_samples = counts.first().map(|c| c.samples);
+    let base_samples = bench.counts.first().map(|c| c.samples);
     for (i, (name, t)) in names.iter().zip(ms).enumerate() {
         let note = if i == 0 { base_note } else { note };
         rows.push(Row {
@@ -245,8 +260,9 @@ pub(super) fn push_group(
             config: name.to_string(),
             ms: *t,
             baseline: base.clone(),
-            ratio: t / ms[0].max(1e-9),
-            sample_ratio: base_samples.zip(counts.get(i)).map(|(b, c)| c.samples as f64 / b.max(1) as f64),
+            ratio: bench.paired.get(i).map_or(t / ms[0].max(1e-9), |p| p.ratio),
+            sample_ratio: base_samples.zip(bench.counts.get(i)).map(|(b, c)| c.samples as f64 / b.max(1) as f64),
+            spread: bench.paired.get(i).map(|p| p.spread),
             note: note.into(),
         });
     }
@@ -267,4 +283,21 @@ pub(super) fn share_differing(a: &image::RgbaImage, b: &image::RgbaImage, levels
         over += usize::from((0..3).any(|c| p[c].abs_diff(q[c]) > levels));
     }
     100.0 * over as f64 / n.max(1) as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Paired;
+
+    #[test]
+    fn a_paired_ratio_is_the_median_and_half_the_interquartile_range() {
+        // Sorted 1.0 1.1 1.2 1.3 2.0: median 1.2; quartiles at 1.1 and 1.3.
+        let p = Paired::of(vec![1.3, 1.0, 2.0, 1.2, 1.1]);
+        assert!((p.ratio - 1.2).abs() < 1e-12 && (p.spread - 0.1).abs() < 1e-12, "{p:?}");
+        // Four: median between 1.1 and 1.2; quartiles at 1.075 and 1.225 (numpy's
+        // default interpolation).
+        let p = Paired::of(vec![1.0, 1.1, 1.2, 1.3]);
+        assert!((p.ratio - 1.15).abs() < 1e-12 && (p.spread - 0.075).abs() < 1e-12, "{p:?}");
+        assert!(Paired::of(Vec::new()).ratio.is_nan());
+    }
 }
