@@ -31,7 +31,7 @@
 // loops that some lane never leaves; the comments below say where that shaped the code.
 
 #import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput
-#import focal::types::{Region, MODE_TWO_LEVEL, MODE_MIP, MODE_MIN_IP, MODE_X_RAY, MODE_ISO, REGION_LABELS, REGION_OCCUPANCY, VIEW_JITTER, VIEW_SKIP_EMPTY, VIEW_EARLY_TERMINATION, VIEW_DEBUG_RAYS, VIEW_DEBUG_COUNTS, EARLY_TERMINATION, MAX_RAY_REGIONS, REGION_CLUSTER}
+#import focal::types::{Region, MODE_TWO_LEVEL, MODE_MIP, MODE_MIN_IP, MODE_ISO, REGION_LABELS, REGION_OCCUPANCY, VIEW_JITTER, VIEW_SKIP_EMPTY, VIEW_EARLY_TERMINATION, VIEW_DEBUG_RAYS, VIEW_DEBUG_COUNTS, EARLY_TERMINATION, MAX_RAY_REGIONS, REGION_CLUSTER}
 #import focal::bindings::{settings, scene, regions, depth_texture}
 #import focal::camera::{Ray, pixel_ray, scene_depth_t, jitter}
 #import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod}
@@ -39,7 +39,7 @@
 #import focal::sampling::{trilinear, brick_occupied, brick_range, at_full_resolution, count_sample, ray_sample_count}
 #import focal::bricked::page_lookup_count
 #import focal::selection::{region_weight, set_weight, pick_weight, set_companion, no_companion}
-#import focal::samples::{is_projection, dvr_sample, is_dvr_like, iso_hit, emit_projection}
+#import focal::samples::{is_projection, dvr_sample, is_dvr_like, iso_hit, emit_projection, projection_takes}
 #import focal::segments::{DONE, HAS_PREV, PAIRABLE, CLOSES, Segment, segment_t, segment_point, past_brick, past_empty_bricks, past_empty_pair, cut_intervals, compact_intervals, leaves}
 #ifdef HAS_TWO_LEVEL
 #import focal::two_level::{NO_PART, Open, fresh, close_segment, end_segment, two_level_sample, open_part}
@@ -302,21 +302,26 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                         break;
                     }
                     let q = segment_point(g, kk);
-                    // Bricks that cannot change the running max (min) need no samples
-                    // (their ranges hold for full-resolution samples only).
-                    if skip && c > 0u && r.mode != MODE_X_RAY && at_full_resolution() {
+                    // Bricks that cannot change the running max (min), or whose values
+                    // all lie outside the projection's range, need no samples (their
+                    // ranges hold for full-resolution samples only).
+                    if skip && at_full_resolution() {
                         let range = brick_range(r, q);
-                        if (r.mode == MODE_MIP && range.y <= mx) || (r.mode == MODE_MIN_IP && range.x >= mn) {
+                        let outside = range.y < r.projection.x || range.x > r.projection.y;
+                        let no_change = c > 0u && ((r.mode == MODE_MIP && range.y <= mx) || (r.mode == MODE_MIN_IP && range.x >= mn));
+                        if outside || no_change {
                             kk = past_brick(r, g, q, kk);
                             continue;
                         }
                     }
                     count_sample();
                     let v = trilinear(r, q);
-                    mx = max(mx, v);
-                    mn = min(mn, v);
-                    sum += v;
-                    c++;
+                    if projection_takes(r, v) {
+                        mx = max(mx, v);
+                        mn = min(mn, v);
+                        sum += v;
+                        c++;
+                    }
                     kk += 1.0;
                 }
                 vmax[s] = mx;
@@ -485,10 +490,12 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
             if is_projection(r.mode) {
                 count_sample();
                 let v = trilinear(r, q);
-                vmax[s] = max(vmax[s], v);
-                vmin[s] = min(vmin[s], v);
-                vsum[s] += v;
-                count[s]++;
+                if projection_takes(r, v) {
+                    vmax[s] = max(vmax[s], v);
+                    vmin[s] = min(vmin[s], v);
+                    vsum[s] += v;
+                    count[s]++;
+                }
                 if leaving {
                     acc = emit_projection(r, vmax[s], vmin[s], vsum[s], count[s], acc);
                 }

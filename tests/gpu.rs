@@ -161,6 +161,17 @@ fn each_mode_matches_the_reference(gpu: &mut Gpu) {
             framed(&inverted, View::Left, true),
         ),
         (
+            // MinIP above the air around the engine (radiology's value floor): the part,
+            // not the black of the air every ray crosses.
+            "minip_engine_above_air",
+            engine.clone(),
+            Appearance {
+                projection_range: Some((80.0, 255.0)),
+                ..Appearance::new(Mode::MinIp, presets::builtin("grayscale_ramp").unwrap())
+            },
+            framed(&engine, View::Oblique, false),
+        ),
+        (
             "xray_head",
             h.clone(),
             Appearance::new(Mode::XRay, presets::builtin("grayscale_ramp").unwrap()),

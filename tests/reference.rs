@@ -84,6 +84,51 @@ fn orthographic_minip_equals_the_voxel_minimum() {
     projection_matches(Mode::MinIp, false, |c| c.iter().cloned().fold(f32::MAX, f32::min));
 }
 
+/// A projection with a value range takes only the column's samples within it; a column
+/// with none draws nothing.
+fn projection_within_matches(mode: Mode, reduce: impl Fn(&[f32]) -> f32) {
+    let dims = UVec3::new(24, 20, 16);
+    let v = noise_volume(dims, false);
+    let (min, max) = (v.stats.min, v.stats.max);
+    // Narrow: about half the columns of 16 uniform samples have none within it.
+    let range = (min + 0.50 * (max - min), min + 0.55 * (max - min));
+    let mut a = Appearance::new(mode, opaque_ramp());
+    a.step = 1.0;
+    a.projection_range = Some(range);
+    let scene = RenderScene::single(Arc::new(v.clone()), a);
+    let img = render(&scene, &top_camera(dims), dims.x, dims.y).unwrap();
+    let code_max = v.code_max() as f32;
+    let (lo, hi) = (v.real_to_normalized(range.0) as f32, v.real_to_normalized(range.1) as f32);
+    let (mut empty, mut taken) = (0, 0);
+    for py in 0..dims.y {
+        for px in 0..dims.x {
+            let (i, j) = (px, dims.y - 1 - py);
+            let column: Vec<f32> = (0..dims.z).map(|k| v.code(i, j, k) as f32 / code_max).filter(|c| (lo..=hi).contains(c)).collect();
+            let got = img.value[(py * dims.x + px) as usize];
+            if column.is_empty() {
+                empty += 1;
+                assert!(
+                    got.is_nan() && img.at(px, py).truncate() == glam::Vec3::ZERO,
+                    "{mode:?} pixel ({px},{py}) drew {got} ({}) from no sample",
+                    img.at(px, py)
+                );
+            } else {
+                taken += 1;
+                let want = reduce(&column);
+                assert!((got - want).abs() < 2e-6, "{mode:?} pixel ({px},{py}): {got} vs {want}");
+            }
+        }
+    }
+    assert!(taken > 0 && empty > 0, "{mode:?}: {taken} columns with samples within the range, {empty} without");
+}
+
+#[test]
+fn a_projections_value_range_leaves_out_the_samples_outside_it() {
+    projection_within_matches(Mode::Mip, |c| c.iter().cloned().fold(f32::MIN, f32::max));
+    projection_within_matches(Mode::MinIp, |c| c.iter().cloned().fold(f32::MAX, f32::min));
+    projection_within_matches(Mode::XRay, |c| c.iter().sum::<f32>() / c.len() as f32);
+}
+
 #[test]
 fn orthographic_xray_equals_the_mean() {
     projection_matches(Mode::XRay, false, |c| c.iter().sum::<f32>() / c.len() as f32);

@@ -115,5 +115,6 @@ fn pick_region(a: Region, b: Region, second: bool) -> Region {
     r.sphere = select(a.sphere, b.sphere, second);
     r.bounds = select(a.bounds, b.bounds, second);
     r.objects = select(a.objects, b.objects, second);
+    r.projection = select(a.projection, b.projection, second);
     return r;
 }

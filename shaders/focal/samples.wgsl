@@ -183,6 +183,11 @@ fn is_dvr_like(mode: u32, flags: u32) -> bool {
     return (flags & REGION_LABELS) != 0u || !(is_projection(mode) || mode == MODE_ISO);
 }
 
+// Whether a projection of r takes normalised sample v (Appearance::projection_range).
+fn projection_takes(r: Region, v: f32) -> bool {
+    return v >= r.projection.x && v <= r.projection.y;
+}
+
 fn projected(mode: u32, vmax: f32, vmin: f32, vsum: f32, count: u32) -> f32 {
     if mode == MODE_MIP {
         return vmax;

@@ -12,7 +12,7 @@
 #import focal::transfer::classify
 #import focal::compositing::composite
 #import focal::segments::{DONE, HAS_PREV}
-#import focal::samples::{is_projection, projected, dvr_classified, iso_surface, iso_hit}
+#import focal::samples::{is_projection, projected, dvr_classified, iso_surface, iso_hit, projection_takes}
 
 #ifdef HAS_TWO_LEVEL
 // Two-level rendering (src/region/appearance.rs): the segment of a segmented region the ray is in
@@ -99,10 +99,12 @@ fn two_level_sample(r: Region, labels: Region, part: ptr<function, Region>, open
     }
 #ifdef HAS_PROJECTION
     if is_projection((*part).mode) {
-        (*open).max = max((*open).max, v);
-        (*open).min = min((*open).min, v);
-        (*open).sum += v;
-        (*open).count++;
+        if projection_takes(*part, v) {
+            (*open).max = max((*open).max, v);
+            (*open).min = min((*open).min, v);
+            (*open).sum += v;
+            (*open).count++;
+        }
         return out;
     }
 #endif

@@ -56,6 +56,10 @@ pub struct RenderArgs {
     /// Iso-value in the data's units (iso mode; default: the middle of the value range).
     #[arg(long, allow_hyphen_values = true)]
     iso: Option<f64>,
+    /// Projections (mip, minip, xray) take only samples within LOW,HIGH (the data's
+    /// units): a MinIP above the air around an object, a MIP below metal.
+    #[arg(long, value_name = "LOW,HIGH", allow_hyphen_values = true, value_parser = parse_range)]
+    projection_range: Option<(f64, f64)>,
     /// Do not jitter ray starts.
     #[arg(long)]
     no_jitter: bool,
@@ -167,6 +171,7 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
         shading,
         step: args.step,
         iso: args.iso,
+        projection_range: args.projection_range,
         context: {
             let d = ContextParams::default();
             ContextParams { kappa_t: args.kappa_t.unwrap_or(d.kappa_t), kappa_s: args.kappa_s.unwrap_or(d.kappa_s), ..d }
@@ -227,4 +232,13 @@ pub fn run_headless(volume: Option<&Path>, out: &Path) -> Result<(), String> {
     let (_, image) = images.into_iter().next().ok_or("nothing rendered")?;
     eprintln!("no display: rendered the default view headless");
     save(&image, out)
+}
+
+/// `LOW,HIGH` as two numbers.
+fn parse_range(text: &str) -> Result<(f64, f64), String> {
+    let (lo, hi) = text.split_once(',').ok_or_else(|| format!("'{text}' is not LOW,HIGH"))?;
+    let number = |t: &str| t.trim().parse::<f64>().map_err(|e| format!("'{t}' in '{text}': {e}"));
+    let range = (number(lo)?, number(hi)?);
+    focal::region::appearance_spec::check_projection_range(range)?;
+    Ok(range)
 }

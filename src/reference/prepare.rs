@@ -57,6 +57,8 @@ pub struct PreparedRegion<'a> {
     pub to_native: Mat3,
     /// Iso-value as a normalised sample.
     pub iso: f32,
+    /// The normalised samples a projection takes (inclusive; `Appearance::projection_range`).
+    pub projection: (f32, f32),
     /// Largest gradient magnitude (normalised units per voxel), for gradient modulation.
     pub gradient_max: f32,
     /// Per-brick visibility (DVR modes with a transfer function): invisible bricks add
@@ -162,6 +164,7 @@ impl<'a> PreparedRegion<'a> {
             normal_matrix: a.transpose(),
             to_native: index_to_native * a,
             iso: volume.real_to_normalized(appearance.iso_value) as f32,
+            projection: projection_range(appearance, volume),
             gradient_max: volume.gradient_max().max(1e-6),
             occupancy,
             context: appearance.context,
@@ -255,4 +258,17 @@ pub fn bounding_sphere(region: &Region, volume: &Volume) -> (Vec3, f32) {
     let dims = volume.dims().as_vec3();
     let centre = to_world.transform_point3(dims * 0.5 - 0.5);
     (centre, 0.5 * crate::region::longest_diagonal(Mat3::from(to_world.matrix3), dims))
+}
+
+/// The normalised samples a projection of `appearance` takes from `volume`: its
+/// projection range as codes, or all (the ends as far as f32 holds, for the GPU).
+pub fn projection_range(appearance: &Appearance, volume: &Volume) -> (f32, f32) {
+    match appearance.projection_range {
+        Some((lo, hi)) => {
+            let (a, b) = (volume.real_to_normalized(lo) as f32, volume.real_to_normalized(hi) as f32);
+            // (A negative rescale slope turns the range round.)
+            (a.min(b), a.max(b))
+        }
+        None => (f32::MIN, f32::MAX),
+    }
 }

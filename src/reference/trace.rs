@@ -234,6 +234,9 @@ fn sample(out: &mut Traced, r: &PreparedRegion, g: &mut Gathered, ratio: f32, p:
         Mode::Mip | Mode::MinIp | Mode::XRay => {
             out.classified += 1;
             let v = r.sample(q, level);
+            if !(r.projection.0..=r.projection.1).contains(&v) {
+                return;
+            }
             g.max = g.max.max(v);
             g.min = g.min.min(v);
             g.sum += v;

@@ -196,6 +196,10 @@ pub struct Appearance {
     pub segmentation: Option<Segmentation>,
     /// Opacity weighted by a selection ([`SelectionWeight`]).
     pub selection: Option<SelectionWeight>,
+    /// Projections (MIP, MinIP, X-ray) take only the samples within this range of
+    /// values (the data's units, inclusive), as radiology viewers' thresholds do: a
+    /// MinIP above the air around an object, a MIP below metal. `None`: every sample.
+    pub projection_range: Option<(f64, f64)>,
 }
 
 impl Appearance {
@@ -209,6 +213,7 @@ impl Appearance {
             context: ContextParams::default(),
             segmentation: None,
             selection: None,
+            projection_range: None,
         }
     }
 

@@ -55,6 +55,10 @@ pub struct AppearanceSpec {
     /// κt, κs of the context-preserving mode.
     #[serde(default)]
     pub context: ContextParams,
+    /// Projections take only samples within (low, high), the data's units
+    /// ([`Appearance::projection_range`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub projection_range: Option<(f64, f64)>,
     /// Two-level rendering: objects from a label dataset, each with its own appearance;
     /// this appearance draws the rest.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -108,6 +112,7 @@ impl Default for AppearanceSpec {
             step: 0.5,
             iso: None,
             context: ContextParams::default(),
+            projection_range: None,
             segmentation: None,
         }
     }
@@ -164,6 +169,9 @@ impl AppearanceSpec {
         if !(0.01..=16.0).contains(&self.step) {
             return Err(format!("step {} is outside 0.01..16 voxels", self.step));
         }
+        if let Some(range) = self.projection_range {
+            check_projection_range(range)?;
+        }
         Ok(Appearance {
             mode: self.mode,
             lookup,
@@ -173,6 +181,7 @@ impl AppearanceSpec {
             context: self.context.validated()?,
             segmentation: None,
             selection: None,
+            projection_range: self.projection_range,
         })
     }
 
@@ -208,9 +217,18 @@ impl AppearanceSpec {
             step: a.step,
             iso: Some(a.iso_value),
             context: a.context,
+            projection_range: a.projection_range,
             segmentation: None,
         }
     }
+}
+
+/// A projection range is finite and not empty; the message names the problem.
+pub fn check_projection_range((lo, hi): (f64, f64)) -> Result<(), String> {
+    if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+        return Err(format!("projection_range ({lo}, {hi}) must be two finite values, low ≤ high"));
+    }
+    Ok(())
 }
 
 impl LabelsSpec {

@@ -191,6 +191,9 @@ pub struct GpuRegion {
     /// A bricked volume's level-0 voxel dims (xyz) and its page table's directory level
     /// `G` (w; `render::bricked::page_table`).
     pub bricked_dims: UVec4,
+    /// Projections: the normalised samples they take (inclusive; xy), from
+    /// `Appearance::projection_range`.
+    pub projection: Vec4,
 }
 
 /// Regions the interval loop tests together (`REGION_CLUSTER` in

@@ -274,6 +274,11 @@ pub enum Change {
         dataset: usize,
         value: f64,
     },
+    /// Projections take only samples within `range` (`None`: all).
+    ProjectionRange {
+        dataset: usize,
+        range: Option<(f64, f64)>,
+    },
     Shading {
         dataset: usize,
         enabled: bool,

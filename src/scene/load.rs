@@ -285,6 +285,12 @@ pub fn apply(change: &Change, datasets: &mut [LoadedDataset], scene: &mut SceneF
         }
         Change::Step { dataset, step } => datasets[get(*dataset)?].appearance.step = *step,
         Change::Iso { dataset, value } => datasets[get(*dataset)?].appearance.iso_value = *value,
+        Change::ProjectionRange { dataset, range } => {
+            if let Some(r) = range {
+                crate::region::appearance_spec::check_projection_range(*r)?;
+            }
+            datasets[get(*dataset)?].appearance.projection_range = *range;
+        }
         Change::Shading { dataset, enabled } => datasets[get(*dataset)?].appearance.shading.enabled = *enabled,
         Change::Context { dataset, context } => datasets[get(*dataset)?].appearance.context = context.validated()?,
         Change::Clip { dataset, clip } => datasets[get(*dataset)?].clip = clip.clone().validated()?,
@@ -464,6 +470,23 @@ mod tests {
         // Saved and read back.
         let round = SceneFile::parse(&s.to_ron().unwrap(), "again").unwrap();
         assert_eq!(round.datasets[0].clip, s.datasets[0].clip);
+    }
+
+    #[test]
+    fn a_projection_range_comes_from_the_scene_and_its_frames() {
+        let text = "(datasets: [(source: Phantom(kind: engine, resolution: 24), appearance: (mode: minip, projection_range: Some((80.0, 255.0))))])";
+        let s = SceneFile::parse(text, "t").unwrap();
+        let mut d = load_datasets(&s, Path::new(".")).unwrap();
+        assert_eq!(d[0].appearance.projection_range, Some((80.0, 255.0)));
+        let mut s2 = s.clone();
+        apply(&Change::ProjectionRange { dataset: 0, range: None }, &mut d, &mut s2, Path::new(".")).unwrap();
+        assert_eq!(d[0].appearance.projection_range, None);
+        // Low above high, or not finite, is refused with the field named.
+        let e = apply(&Change::ProjectionRange { dataset: 0, range: Some((5.0, 1.0)) }, &mut d, &mut s2, Path::new(".")).unwrap_err();
+        assert!(e.contains("projection_range"), "{e}");
+        let bad = SceneFile::parse(&text.replace("(80.0, 255.0)", "(80.0, inf)"), "t").unwrap();
+        let e = load_datasets(&bad, Path::new(".")).unwrap_err();
+        assert!(e.contains("projection_range") && e.contains("dataset 0"), "{e}");
     }
 
     #[test]

@@ -397,6 +397,25 @@ fn transfer_panel(ui: &mut Ui, d: &mut Dataset, entity: Entity, editor: &mut tf_
     }
 }
 
+/// A projection's value range: off, or low and high within the data's range (low kept
+/// at most high).
+fn projection_range_controls(ui: &mut Ui, range: &mut Option<(f64, f64)>, (lo, hi): (f64, f64)) {
+    let mut on = range.is_some();
+    if ui
+        .checkbox(&mut on, "only values within a range")
+        .on_hover_text("MinIP above the air around an object, MIP below metal: samples outside are left out")
+        .changed()
+    {
+        // Off to on: from a tenth of the way up (above the background) to the top.
+        *range = on.then_some((lo + 0.1 * (hi - lo), hi));
+    }
+    if let Some((low, high)) = range {
+        ui.add(egui::Slider::new(low, lo..=hi).text("lowest value"));
+        ui.add(egui::Slider::new(high, lo..=hi).text("highest value"));
+        *high = high.max(*low);
+    }
+}
+
 fn rendering_panel(ui: &mut Ui, d: &mut Dataset, state: &mut AppState, light: &mut SceneLight) {
     let a = &mut d.appearance;
     egui::ComboBox::from_label("mode").selected_text(mode_name(a.mode)).show_ui(ui, |ui| {
@@ -407,6 +426,9 @@ fn rendering_panel(ui: &mut Ui, d: &mut Dataset, state: &mut AppState, light: &m
     if a.mode == Mode::Iso {
         let (lo, hi) = (d.volume.stats.min, d.volume.stats.max);
         ui.add(egui::Slider::new(&mut a.iso_value, lo..=hi).text("iso-value"));
+    }
+    if a.mode.is_projection() {
+        projection_range_controls(ui, &mut a.projection_range, (d.volume.stats.min, d.volume.stats.max));
     }
     if a.mode == Mode::Context {
         let c = &mut a.context;
