@@ -81,6 +81,8 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
     var ratios: array<f32, MAX_RAY_REGIONS>;
     // DONE, HAS_PREV; PAIRABLE, CLOSES (the region's kind).
     var state: array<u32, MAX_RAY_REGIONS>;
+    // The region's projection group (render::pack: Region.projection.z).
+    var groups: array<u32, MAX_RAY_REGIONS>;
     var n = 0u;
     var t_start = 3.4e38;
     var t_end = -3.4e38;
@@ -138,14 +140,17 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                     let mode = regions[i].mode;
                     var kind = select(0u, CLOSES, is_projection(mode) || mode == MODE_TWO_LEVEL);
                     kind |= select(0u, PAIRABLE, is_dvr_like(mode, regions[i].flags));
+                    let group = u32(regions[i].projection.z);
 #ifdef HAS_HOLES
                     for (var e = first; e < n; e++) {
                         ratios[e] = factor;
                         state[e] = kind;
+                        groups[e] = group;
                     }
 #else
                     ratios[first] = factor;
                     state[first] = kind;
+                    groups[first] = group;
 #endif
                 }
             }
@@ -329,7 +334,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                 vsum[s] = sum;
                 count[s] = c;
                 if leaves(t_start, k_end, j, step, t1s[s]) {
-                    acc = emit_projection(r, mx, mn, sum, c, acc);
+                    acc = leave_projection(r, s, n, &groups, &state, &t1s, &vmax, &vmin, &vsum, &count, acc);
                     state[s] |= DONE;
                 }
             } else
@@ -497,7 +502,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                     count[s]++;
                 }
                 if leaving {
-                    acc = emit_projection(r, vmax[s], vmin[s], vsum[s], count[s], acc);
+                    acc = leave_projection(r, s, n, &groups, &state, &t1s, &vmax, &vmin, &vsum, &count, acc);
                 }
             } else
 #endif
@@ -538,7 +543,8 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
             continue;
         }
         let r = regions[ids[s]];
-        acc = emit_projection(r, vmax[s], vmin[s], vsum[s], count[s], acc);
+        acc = leave_projection(r, s, n, &groups, &state, &t1s, &vmax, &vmin, &vsum, &count, acc);
+        state[s] |= DONE;
 #ifdef HAS_TWO_LEVEL
         if r.mode == MODE_TWO_LEVEL {
             var o = opens[s];
@@ -550,6 +556,28 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
         return debug_counts();
     }
     return acc;
+}
+
+// The ray leaves projection interval s (region r): what it gathered goes on to a later
+// interval of the same projection group the ray has not left (the parts of an exploded
+// view, the rest beside a same-look window: one MIP along the whole ray), else it is
+// emitted (reference: trace::leave). Anything else: acc unchanged.
+fn leave_projection(r: Region, s: u32, n: u32, groups: ptr<function, array<u32, MAX_RAY_REGIONS>>, state: ptr<function, array<u32, MAX_RAY_REGIONS>>, t1s: ptr<function, array<f32, MAX_RAY_REGIONS>>, vmax: ptr<function, array<f32, MAX_RAY_REGIONS>>, vmin: ptr<function, array<f32, MAX_RAY_REGIONS>>, vsum: ptr<function, array<f32, MAX_RAY_REGIONS>>, count: ptr<function, array<u32, MAX_RAY_REGIONS>>, acc: vec4<f32>) -> vec4<f32> {
+    if !is_projection(r.mode) {
+        return acc;
+    }
+    let t1 = (*t1s)[s];
+    for (var h = 0u; h < n; h++) {
+        let later = (*t1s)[h] > t1 || ((*t1s)[h] == t1 && h > s);
+        if h != s && ((*state)[h] & DONE) == 0u && (*groups)[h] == (*groups)[s] && later {
+            (*vmax)[h] = max((*vmax)[h], (*vmax)[s]);
+            (*vmin)[h] = min((*vmin)[h], (*vmin)[s]);
+            (*vsum)[h] += (*vsum)[s];
+            (*count)[h] += (*count)[s];
+            return acc;
+        }
+    }
+    return emit_projection(r, (*vmax)[s], (*vmin)[s], (*vsum)[s], (*count)[s], acc);
 }
 
 // The ray's counts as render::counts decodes them: samples in red (low byte) and green

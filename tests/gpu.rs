@@ -367,7 +367,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 29] = [
+    let tests: [GpuTest; 30] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -392,6 +392,7 @@ fn main() {
         ("a_magnifying_window_enlarges_its_source", windows::a_magnifying_window_enlarges_its_source),
         ("an_exploded_head_matches_the_reference", explode::an_exploded_head_matches_the_reference),
         ("eighteen_exploded_parts_match_the_reference", explode::eighteen_exploded_parts_match_the_reference),
+        ("a_mip_of_exploded_parts_is_one_maximum_along_the_ray", explode::a_mip_of_exploded_parts_is_one_maximum_along_the_ray),
         ("a_selection_on_its_own_grid_matches_the_reference", explode::a_selection_on_its_own_grid_matches_the_reference),
         ("bricked_ch2_converges_to_the_chosen_level_in_memory", bricked::bricked_ch2_converges_to_the_chosen_level_in_memory),
         ("two_level_on_bricked_data_matches_memory", bricked::two_level_on_bricked_data_matches_memory),

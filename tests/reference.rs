@@ -130,6 +130,42 @@ fn a_projections_value_range_leaves_out_the_samples_outside_it() {
 }
 
 #[test]
+fn a_projection_split_into_regions_is_one_projection_along_the_whole_ray() {
+    // The volume as two regions along the ray (the parts of an exploded view at rest, a
+    // same-look window and the rest): MIP, MinIP and X-ray of the pair equal those of the
+    // whole volume, not the front part's value composited over the back part's.
+    let dims = UVec3::new(24, 20, 16);
+    let v = Arc::new(noise_volume(dims, false));
+    for mode in [Mode::Mip, Mode::MinIp, Mode::XRay] {
+        let mut a = Appearance::new(mode, opaque_ramp());
+        a.step = 1.0;
+        let whole = RenderScene::single(v.clone(), a.clone());
+        let whole_img = render(&whole, &top_camera(dims), dims.x, dims.y).unwrap();
+        let mut split = RenderScene::single(v.clone(), a.clone());
+        let box_ = split.regions[0].clone();
+        let lo = Vec3::splat(-0.5);
+        let hi = dims.as_vec3() - 0.5;
+        let mid = 7.5;
+        // Two appearances equal by value, as an exploded view's parts have.
+        split.appearances.push(a.clone());
+        split.regions = vec![
+            box_.cut_to_index_box(lo, Vec3::new(hi.x, hi.y, mid)),
+            Region { appearance: 1, ..box_.cut_to_index_box(Vec3::new(lo.x, lo.y, mid), hi) },
+        ];
+        let split_img = render(&split, &top_camera(dims), dims.x, dims.y).unwrap();
+        for (i, (w, s)) in whole_img.value.iter().zip(&split_img.value).enumerate() {
+            assert!((w - s).abs() < 2e-6, "{mode:?} pixel {i}: whole {w}, split {s}");
+        }
+        let (w, s) = (whole_img.at(3, 4), split_img.at(3, 4));
+        assert!((w - s).abs().max_element() < 1e-5, "{mode:?}: colour {w} whole, {s} split");
+        // A different look is another projection: composited in depth order.
+        split.appearances[1] = Appearance { shading: focal::region::Shading { ambient: 0.5, ..a.shading }, ..a.clone() };
+        let apart = render(&split, &top_camera(dims), dims.x, dims.y).unwrap();
+        assert_ne!(apart.value, split_img.value, "{mode:?}: regions with different looks were projected together");
+    }
+}
+
+#[test]
 fn orthographic_xray_equals_the_mean() {
     projection_matches(Mode::XRay, false, |c| c.iter().sum::<f32>() / c.len() as f32);
     projection_matches(Mode::XRay, true, |c| c.iter().sum::<f32>() / c.len() as f32);

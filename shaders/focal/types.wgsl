@@ -50,7 +50,8 @@ struct Region {
     bricked_scale: vec4<f32>,
     // Its level-0 voxel dims and page table directory level G.
     bricked_dims: vec4<u32>,
-    // Projections: the normalised samples they take (inclusive range, xy).
+    // Projections: the normalised samples they take (inclusive range, xy) and the
+    // region's projection group (z; raycast.wgsl leave_projection).
     projection: vec4<f32>,
 }
 

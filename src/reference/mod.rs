@@ -45,7 +45,14 @@ pub fn prepare(scene: &RenderScene) -> Result<Vec<PreparedRegion<'_>>, String> {
             }
             Ok(p)
         })
-        .collect()
+        .collect::<Result<Vec<_>, String>>()
+        .map(|mut prepared| {
+            let groups = prepare::projection_groups(&prepared, &scene.appearances);
+            for (p, g) in prepared.iter_mut().zip(groups) {
+                p.projection_group = g;
+            }
+            prepared
+        })
 }
 
 /// Renders `scene` seen by `camera` into a `width × height` image.

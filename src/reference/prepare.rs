@@ -59,6 +59,11 @@ pub struct PreparedRegion<'a> {
     pub iso: f32,
     /// The normalised samples a projection takes (inclusive; `Appearance::projection_range`).
     pub projection: (f32, f32),
+    /// The projection this region's samples belong to ([`projection_groups`]): the index
+    /// of the first region showing the same volume with the same projecting look (the
+    /// parts of an exploded view, the rest beside a same-look window), one value along the
+    /// whole ray; the region's own index otherwise.
+    pub projection_group: usize,
     /// Largest gradient magnitude (normalised units per voxel), for gradient modulation.
     pub gradient_max: f32,
     /// Per-brick visibility (DVR modes with a transfer function): invisible bricks add
@@ -165,6 +170,7 @@ impl<'a> PreparedRegion<'a> {
             to_native: index_to_native * a,
             iso: volume.real_to_normalized(appearance.iso_value) as f32,
             projection: projection_range(appearance, volume),
+            projection_group: usize::MAX,
             gradient_max: volume.gradient_max().max(1e-6),
             occupancy,
             context: appearance.context,
@@ -271,4 +277,26 @@ pub fn projection_range(appearance: &Appearance, volume: &Volume) -> (f32, f32) 
         }
         None => (f32::MIN, f32::MAX),
     }
+}
+
+/// Each region's projection group ([`PreparedRegion::projection_group`]): regions that
+/// project (MIP, MinIP, X-ray, not segmented) the same volume with equal looks share the
+/// first one's index; every other region has its own. Looks are the scene's
+/// `appearances` compared by value (an exploded view gives each part its own copy).
+pub fn projection_groups(prepared: &[PreparedRegion], appearances: &[Appearance]) -> Vec<usize> {
+    let projects = |p: &PreparedRegion| p.objects.is_none() && p.mode.is_projection();
+    (0..prepared.len())
+        .map(|i| {
+            let (p, look) = (&prepared[i], appearances.get(prepared[i].region.appearance));
+            if !projects(p) {
+                return i;
+            }
+            (0..i)
+                .find(|&j| {
+                    let q = &prepared[j];
+                    projects(q) && q.region.volume == p.region.volume && appearances.get(q.region.appearance) == look
+                })
+                .unwrap_or(i)
+        })
+        .collect()
 }

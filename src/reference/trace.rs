@@ -168,17 +168,18 @@ pub fn trace_antialiased(
         out.samples = k;
         let p = ray.at(t);
         let at = Sampling { ray: &ray, light, level: footprint.map_or(0.0, |f| f.level(t, MIP_LEVELS as f32)), depth_threshold };
-        for st in &mut states {
-            let (i, r) = (st.region, &regions[st.region]);
-            if st.done {
+        for si in 0..states.len() {
+            let (i, r) = (states[si].region, &regions[states[si].region]);
+            if states[si].done {
                 continue;
             }
-            if t > st.t1 {
-                // Left this region: a projection (or the open segment) emits its value now.
-                close(&mut out, r, st, t, i, depth_threshold);
-                st.done = true;
+            if t > states[si].t1 {
+                // Left this region: a projection (or the open segment) emits its value
+                // now, or hands it on to a later interval of the same projection.
+                leave(&mut out, regions, &mut states, si, t, depth_threshold);
                 continue;
             }
+            let st = &mut states[si];
             if t < st.t0 {
                 continue;
             }
@@ -215,9 +216,10 @@ pub fn trace_antialiased(
         }
     }
     // Projections (and segments) still open at the end of the march.
-    for st in &mut states {
-        if !st.done && out.color.w < stop {
-            close(&mut out, &regions[st.region], st, st.t1, st.region, depth_threshold);
+    for si in 0..states.len() {
+        if !states[si].done && out.color.w < stop {
+            let t1 = states[si].t1;
+            leave(&mut out, regions, &mut states, si, t1, depth_threshold);
         }
     }
     out
@@ -297,6 +299,29 @@ fn iso_surface(out: &mut Traced, r: &PreparedRegion, qh: Vec3, th: f32, i: usize
     let grad = r.index_gradient_at(qh, at.level);
     let c = shade(Vec3::new(rgba[0], rgba[1], rgba[2]), r.normal_matrix * grad, at.ray.dir, at.light, &r.shading);
     composite(out, c, 1.0, th, i, at.depth_threshold);
+}
+
+/// The ray leaves interval `si` at ray parameter `t`: what a projection gathered goes on
+/// to a later interval of the same projection group that the ray has not left (so a MIP
+/// of an exploded view, or of a dataset beside a same-look window, is the maximum along
+/// the whole ray, emitted once after its last interval), else it is emitted ([`close`]).
+fn leave(out: &mut Traced, regions: &[PreparedRegion], states: &mut [State], si: usize, t: f32, threshold: f32) {
+    let st = states[si];
+    let r = &regions[st.region];
+    if r.objects.is_none() && r.mode.is_projection() {
+        let later = |(h, o): &(usize, &State)| {
+            *h != si && !o.done && regions[o.region].projection_group == r.projection_group && (o.t1 > st.t1 || (o.t1 == st.t1 && *h > si))
+        };
+        if let Some((h, _)) = states.iter().enumerate().find(|e| later(e)) {
+            let (g, a) = (&mut states[h].gathered, st.gathered);
+            (g.max, g.min, g.sum, g.count) = (g.max.max(a.max), g.min.min(a.min), g.sum + a.sum, g.count + a.count);
+            states[si].gathered = Gathered::EMPTY;
+            states[si].done = true;
+            return;
+        }
+    }
+    close(out, r, &mut states[si], t, st.region, threshold);
+    states[si].done = true;
 }
 
 /// Ends what region `r` has gathered at ray parameter `t` (leaving the region, or its

@@ -192,7 +192,8 @@ pub struct GpuRegion {
     /// `G` (w; `render::bricked::page_table`).
     pub bricked_dims: UVec4,
     /// Projections: the normalised samples they take (inclusive; xy), from
-    /// `Appearance::projection_range`.
+    /// `Appearance::projection_range`, and the region's projection group (z, as a float:
+    /// `reference::prepare::PreparedRegion::projection_group`).
     pub projection: Vec4,
 }
 

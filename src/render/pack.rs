@@ -445,7 +445,7 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
         bricked: UVec4::ZERO,
         bricked_scale: Vec4::ZERO,
         bricked_dims: UVec4::ZERO,
-        projection: Vec4::new(p.projection.0, p.projection.1, 0.0, 0.0),
+        projection: Vec4::new(p.projection.0, p.projection.1, p.projection_group.min(1 << 24) as f32, 0.0),
     }
 }
 

@@ -138,3 +138,36 @@ pub fn eighteen_exploded_parts_match_the_reference(gpu: &mut Gpu) {
     assert_matches("eighteen_parts_apart", &apart, &render(&scene, &cam, SIZE, SIZE).unwrap().to_image().unwrap());
     gpu.clear();
 }
+
+/// A MIP of an exploded view is one maximum along the whole ray (not each part's maximum
+/// composited over the next): 18 parts around the arteries, at rest and pushed apart,
+/// against the reference.
+pub fn a_mip_of_exploded_parts_is_one_maximum_along_the_ray(gpu: &mut Gpu) {
+    let ct = head();
+    let mip = Appearance::new(Mode::Mip, presets::builtin("grayscale_ramp").unwrap());
+    let cam = framed(&ct, View::Oblique, true);
+    gpu.clear();
+    let world = gpu.off.world_mut();
+    // (Parts that move alike draw as one region: the explosion around a selection, the
+    // arteries, pushes them apart into regions of their own.)
+    let labels = phantom::head::generate(64).unwrap().labels;
+    let ids = [phantom::head::label::ARTERIES as u32].into_iter().collect();
+    let selection = SelectionVolume::from_labels(&labels, &ids).unwrap();
+    let data = world.spawn((Dataset::new(ct.clone(), mip), Transform::default(), Exploded::around(&selection))).id();
+    use focal::explode::spec::{ExplodeSpec, PartsSpec, SelectionSpec};
+    let grid = ExplodeSpec { parts: PartsSpec::Grid((3, 3, 2)), ..ExplodeSpec::around(SelectionSpec::Nothing) }.parts(&ct).unwrap();
+    for rest in grid {
+        spawn_part(world, Part::new(data, rest), Transform::default());
+    }
+    gpu.off.set_camera(&cam);
+    let at_rest = gpu.off.capture().unwrap();
+    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
+    assert_matches("mip_parts_at_rest", &at_rest, &render(&scene, &cam, SIZE, SIZE).unwrap().to_image().unwrap());
+    gpu.off.world_mut().get_mut::<Exploded>(data).unwrap().coefficients.degree = 1.0;
+    step(gpu.off.world_mut(), 300);
+    let apart = gpu.off.capture().unwrap();
+    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
+    assert!(scene.regions.len() >= 18, "{} regions", scene.regions.len());
+    assert_matches("mip_parts_apart", &apart, &render(&scene, &cam, SIZE, SIZE).unwrap().to_image().unwrap());
+    gpu.clear();
+}
