@@ -1,8 +1,8 @@
 //! The geometry of the clip-plane gizmo: where a plane cuts the dataset's box (the
-//! outline drawn over the view) and how a drag on the screen moves the plane along its
-//! normal.
+//! outline drawn over the view), how a drag on the screen moves the plane along its
+//! normal, and how a drag of the rotate handle at its tip turns the normal.
 
-use glam::{Vec2, Vec3};
+use glam::{Quat, Vec2, Vec3};
 
 use crate::region::Plane;
 
@@ -55,9 +55,45 @@ pub fn drag_along_normal(per_mm: Vec2, drag: Vec2) -> f32 {
     if len2 < 1e-6 { 0.0 } else { drag.dot(per_mm) / len2 }
 }
 
+/// The normal after a drag of `drag` pixels (x right, y down) of the rotate handle at
+/// its tip, the camera's right and up axes given in the normal's frame: the tip follows
+/// the pointer. With `d` the drag's direction in the world, the normal turns by
+/// |drag| / `radius` radians about `n × d`, which moves it towards `d` (`(n × d) × n`
+/// is `d` less its part along `n`); a normal facing the viewer turns like a trackball,
+/// a drag along the normal's own direction on the screen turns nothing. Unit length.
+pub fn rotate_normal(normal: Vec3, right: Vec3, up: Vec3, drag: Vec2, radius: f32) -> Vec3 {
+    let n = normal.normalize_or(Vec3::Z);
+    let d = (right * drag.x - up * drag.y).normalize_or_zero();
+    let axis = n.cross(d);
+    if axis.length_squared() < 1e-10 || radius <= 0.0 {
+        return n;
+    }
+    (Quat::from_axis_angle(axis.normalize(), drag.length() / radius) * n).normalize_or(Vec3::Z)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_rotate_handle_turns_the_normal_towards_the_drag() {
+        // Camera looking down −z (right +x, up +y, towards the viewer +z); radius 100 px.
+        let (right, up) = (Vec3::X, Vec3::Y);
+        let quarter = 100.0 * std::f32::consts::FRAC_PI_2;
+        // A normal facing the viewer, dragged a quarter turn to the right, points right.
+        let n = rotate_normal(Vec3::Z, right, up, Vec2::new(quarter, 0.0), 100.0);
+        assert!(n.distance(Vec3::X) < 1e-5, "{n}");
+        // Dragged down (screen y grows downwards) a quarter turn: it points down, −y.
+        let n = rotate_normal(Vec3::Z, right, up, Vec2::new(0.0, quarter), 100.0);
+        assert!(n.distance(-Vec3::Y) < 1e-5, "{n}");
+        // A normal along +x (its tip to the right) dragged 50 px up turns 0.5 rad about
+        // +z: (cos 0.5, sin 0.5, 0).
+        let n = rotate_normal(Vec3::X, right, up, Vec2::new(0.0, -50.0), 100.0);
+        assert!(n.distance(Vec3::new(0.5f32.cos(), 0.5f32.sin(), 0.0)) < 1e-5, "{n}");
+        // Pulled along itself, or not dragged: unchanged (and made unit).
+        assert_eq!(rotate_normal(Vec3::X, right, up, Vec2::new(-40.0, 0.0), 100.0), Vec3::X);
+        assert_eq!(rotate_normal(Vec3::new(0.0, 0.0, 2.0), right, up, Vec2::ZERO, 100.0), Vec3::Z);
+    }
 
     #[test]
     fn an_axis_plane_cuts_a_rectangle() {

@@ -1,7 +1,7 @@
 //! The Clipping panel: clip planes (add, axis or view-facing normal, position along the
 //! normal, flip side, enable, remove, reset) and a clip box (per-axis extent) of the
 //! selected dataset, in the dataset's frame. In the viewport, each plane's handle drags
-//! it along its normal (`super::clip_gizmo`).
+//! it along its normal and the ring at its normal's tip turns it (`super::clip_gizmo`).
 
 use bevy::math::Vec3;
 use bevy_egui::egui::{self, Ui};
