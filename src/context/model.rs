@@ -59,6 +59,15 @@ impl Default for ContextParams {
 }
 
 impl ContextParams {
+    /// Whether equation 5 is plain DVR with these parameters, for λs positive at every
+    /// value (`lambda_s_positive`): with κt = 0 the exponent's base is 0, so the exponent
+    /// is `0^(κs·λs)` = 0 and ‖g‖⁰ = 1 (Schlick's and the exact power alike), leaving
+    /// α = α_TF; only where κs·λs = 0 is the exponent 0⁰ = 1 (gradient-modulated).
+    /// The ray caster then takes DVR's cost path.
+    pub fn is_plain_dvr(&self, lambda_s_positive: bool) -> bool {
+        self.kappa_t == 0.0 && self.kappa_s > 0.0 && lambda_s_positive
+    }
+
     /// Most useful ranges of the sliders.
     pub const KAPPA_T_MAX: f32 = 12.0;
     pub const KAPPA_S_MAX: f32 = 2.0;
@@ -147,6 +156,22 @@ pub fn eye_distance(t: f32, origin: glam::Vec3, dir: glam::Vec3, centre: glam::V
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn is_plain_dvr_holds_where_equation_5_leaves_the_opacity() {
+        // κt = 0 with κs·λs > 0: α = α_TF for every sample (the test below checks eq. 5).
+        let p = ContextParams { kappa_t: 0.0, kappa_s: 0.5, power: Power::Schlick };
+        assert!(p.is_plain_dvr(true));
+        for prev in [0.0, 0.5, 0.9] {
+            let s = Sample { gradient: 0.3, alpha_prev: prev, ..sample() };
+            assert_eq!(opacity(&p, &s), s.alpha);
+        }
+        // κs = 0, or λs = 0 somewhere: the exponent is 0⁰ = 1, α·‖g‖: not DVR.
+        let flat = ContextParams { kappa_s: 0.0, ..p };
+        assert!(!flat.is_plain_dvr(true) && !p.is_plain_dvr(false));
+        assert_eq!(opacity(&flat, &Sample { gradient: 0.5, ..sample() }), 0.8 * 0.5);
+        assert!(!ContextParams { kappa_t: 0.5, ..p }.is_plain_dvr(true));
+    }
 
     fn sample() -> Sample {
         Sample { alpha: 0.8, gradient: 0.5, shading: 0.8, eye_distance: 0.25, alpha_prev: 0.2, lambda: [1.0, 1.0] }

@@ -151,8 +151,9 @@ impl<'a> PreparedRegion<'a> {
             }
             Lookup::Labels(styles) => PreparedLookup::Labels(styles.bake(volume.stats.code_max as usize + 1)),
         };
-        // Label volumes are composited like DVR whatever the mode says.
-        let mode = if labels { Mode::Dvr } else { appearance.mode };
+        // Label volumes are composited like DVR whatever the mode says; context-preserving
+        // DVR at κt = 0 is DVR.
+        let mode = if labels { Mode::Dvr } else { appearance.effective_mode() };
         let occupancy = appearance.brick_occupancy(volume).map(|occ| (volume.bricks(), occ));
         let a = Mat3::from(region.world_to_voxel.matrix3);
         let index_to_native = volume.grid.direction * Mat3::from_diagonal(volume.grid.spacing);

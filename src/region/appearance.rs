@@ -217,6 +217,16 @@ impl Appearance {
         }
     }
 
+    /// The mode the ray caster composites this look with: context-preserving DVR whose
+    /// equation 5 is plain DVR (κt = 0, `ContextParams::is_plain_dvr`) is DVR.
+    pub fn effective_mode(&self) -> Mode {
+        let lambda_s_positive = match &self.lookup {
+            Lookup::Transfer(tf) => tf.lambda_s.iter().all(|p| p.1 > 0.0),
+            Lookup::Labels(_) => true,
+        };
+        if self.mode == Mode::Context && self.context.is_plain_dvr(lambda_s_positive) { Mode::Dvr } else { self.mode }
+    }
+
     /// Whether the look (or an object of its segmentation) weighs samples by the
     /// normalised gradient magnitude (gradient-modulated and context-preserving DVR),
     /// which needs the volume's largest gradient.

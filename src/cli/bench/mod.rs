@@ -164,10 +164,10 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
 
     if all || args.context {
         // Context-preserving rendering against DVR on the engine (shaded, so DVR fetches
-        // the gradient too). κt = 0 draws the DVR picture while evaluating equation 5 at
-        // every sample: the model's own cost (the paper: 5 % with Schlick's
-        // approximation; goal ≤ ×1.05). At κt = 3 the rays also go deeper (less becomes
-        // opaque early), so those frames do more samples as well.
+        // the gradient too). κt = 0 is the DVR picture, and takes DVR's cost path
+        // (ContextParams::is_plain_dvr: equation 5 leaves every opacity; goal ≤ ×1.05).
+        // At κt = 3 the rays also go deeper (less becomes opaque early), so those frames
+        // do more samples as well.
         let engine = Arc::new(Phantom::Engine.generate(args.resolution)?);
         let industrial = presets::builtin("industrial_ct")?;
         let context = |kappa_t: f32, power: Power| Appearance {

@@ -320,3 +320,29 @@ fn a_selection_on_its_datas_grid_rides_in_the_second_channel() {
     let plain = RenderScene::single(v.clone(), Appearance::new(Mode::Dvr, presets::builtin("grayscale_ramp").unwrap()));
     assert_eq!(pack(&plain, 2048).unwrap().doi_channels, vec![None]);
 }
+
+#[test]
+fn context_preserving_dvr_at_kappa_t_zero_takes_dvrs_cost_path() {
+    // κt = 0 is DVR (ContextParams::is_plain_dvr): packed as DVR, no context code in the
+    // pipeline; κt > 0, or λs zero somewhere (0⁰ = 1: gradient modulation), stays.
+    let v = Arc::new(phantom::sphere(16, 5.0).unwrap());
+    let tf = presets::builtin("grayscale_ramp").unwrap();
+    let with = |kappa_t: f32, tf: crate::transfer::TransferFunction| {
+        let a = Appearance {
+            context: crate::context::ContextParams { kappa_t, kappa_s: 0.5, ..Default::default() },
+            ..Appearance::new(crate::region::Mode::Context, tf)
+        };
+        pack(&RenderScene::single(v.clone(), a), 2048).unwrap()
+    };
+    let zero = with(0.0, tf.clone());
+    assert_eq!(zero.regions[0].mode, mode::DVR);
+    assert_eq!(zero.features & super::super::gpu_types::features::CONTEXT, 0);
+    let open = with(3.0, tf.clone());
+    assert_eq!(open.regions[0].mode, mode::CONTEXT);
+    assert_ne!(open.features & super::super::gpu_types::features::CONTEXT, 0);
+    let lambda = crate::transfer::TransferFunction {
+        lambda_s: vec![crate::transfer::OpacityPoint(0.0, 0.0), crate::transfer::OpacityPoint(1.0, 1.0)],
+        ..tf
+    };
+    assert_eq!(with(0.0, lambda).regions[0].mode, mode::CONTEXT);
+}
