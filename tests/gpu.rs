@@ -367,7 +367,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 30] = [
+    let tests: [GpuTest; 31] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -388,6 +388,7 @@ fn main() {
         ("a_clip_box_inside_the_engine_makes_minip_useful", clip::a_clip_box_inside_the_engine_makes_minip_useful),
         ("two_level_matches_the_reference", twolevel::two_level_matches_the_reference),
         ("overlapping_two_level_regions_match_the_reference", twolevel::overlapping_two_level_regions_match_the_reference),
+        ("the_rest_draws_no_rim_beside_a_hidden_object", twolevel::the_rest_draws_no_rim_beside_a_hidden_object),
         ("a_clip_window_shows_nothing_of_the_main_view_inside", windows::a_clip_window_shows_nothing_of_the_main_view_inside),
         ("a_magnifying_window_enlarges_its_source", windows::a_magnifying_window_enlarges_its_source),
         ("an_exploded_head_matches_the_reference", explode::an_exploded_head_matches_the_reference),

@@ -98,7 +98,13 @@ fn a_mip_object_emits_one_value_per_segment() {
     let (data, labels) = phantom();
     let mut hidden_slab = object("slab", vec![3], Mode::Dvr);
     hidden_slab.visible = false;
-    let seg = Segmentation { table: None, labels, objects: vec![object("cube", vec![2], Mode::Mip), hidden_slab], rest_visible: false };
+    let seg = Segmentation {
+        table: None,
+        labels,
+        objects: vec![object("cube", vec![2], Mode::Mip), hidden_slab],
+        rest_visible: false,
+        own_values: false,
+    };
     let s = scene(&data, unshaded(Mode::Dvr), Some(seg));
     // Off the core: the slab splits the cube into two segments of max 100 each, so two
     // samples of opacity 100/255 composite: 1 − (1 − a)², not one max (a).
@@ -118,7 +124,8 @@ fn a_mip_object_emits_one_value_per_segment() {
 #[test]
 fn segments_composite_front_to_back_with_the_rest() {
     let (data, labels) = phantom();
-    let seg = Segmentation { table: None, labels, objects: vec![object("cube", vec![2, 3], Mode::Mip)], rest_visible: true };
+    let seg =
+        Segmentation { table: None, labels, objects: vec![object("cube", vec![2, 3], Mode::Mip)], rest_visible: true, own_values: false };
     let s = scene(&data, unshaded(Mode::Dvr), Some(seg));
     // The plate alone (rest, DVR) seen where nothing is in front of it.
     let plate = pixel(&s, 0.0, 10.0).w;
@@ -136,7 +143,7 @@ fn parts_that_all_draw_alike_are_plain_dvr() {
     let a = Appearance::new(Mode::Dvr, ramp());
     let plain = scene(&data, a.clone(), None);
     let objects = vec![Object::new("ball", vec![1], a.clone()), Object::new("cube", vec![2, 3], a.clone())];
-    let seg = scene(&data, a.clone(), Some(Segmentation { table: None, labels, objects, rest_visible: true }));
+    let seg = scene(&data, a.clone(), Some(Segmentation { table: None, labels, objects, rest_visible: true, own_values: false }));
     for (x, y) in [(-8.0, 0.0), (8.0, 0.0), (8.0, 3.0), (0.0, 10.0), (-6.0, 2.5), (3.0, -4.0)] {
         let (p, q) = (pixel(&plain, x, y), pixel(&seg, x, y));
         assert!((p - q).abs().max_element() < 1e-6, "({x}, {y}): plain {p} vs segmented {q}");
@@ -150,7 +157,7 @@ fn a_hidden_object_is_a_hole_not_the_rest() {
     let shown = scene(&data, rest.clone(), None);
     let mut ball = object("ball", vec![1], Mode::Dvr);
     ball.visible = false;
-    let hidden = scene(&data, rest, Some(Segmentation { table: None, labels, objects: vec![ball], rest_visible: true }));
+    let hidden = scene(&data, rest, Some(Segmentation { table: None, labels, objects: vec![ball], rest_visible: true, own_values: false }));
     let plate = pixel(&shown, 0.0, 10.0).w;
     let (with, without) = (pixel(&shown, -8.0, 0.0).w, pixel(&hidden, -8.0, 0.0).w);
     println!("ball shown {with}, hidden {without}, plate alone {plate}");
@@ -165,7 +172,7 @@ fn value_ranges_move_samples_between_objects() {
     let bright = |range: (f64, f64)| {
         let mut o = object("plate", vec![0], Mode::Mip);
         o.values = Some(range);
-        let seg = Segmentation { table: None, labels: labels.clone(), objects: vec![o], rest_visible: false };
+        let seg = Segmentation { table: None, labels: labels.clone(), objects: vec![o], rest_visible: false, own_values: false };
         pixel(&scene(&data, unshaded(Mode::Dvr), Some(seg)), 0.0, 10.0).w
     };
     // The plate's samples (60) are in the object: its MIP is 60/255.
@@ -179,7 +186,7 @@ fn an_iso_object_is_opaque_at_its_first_crossing() {
     let (data, labels) = phantom();
     let mut ball = object("ball", vec![1], Mode::Iso);
     ball.appearance.iso_value = 75.0;
-    let seg = Segmentation { table: None, labels, objects: vec![ball], rest_visible: false };
+    let seg = Segmentation { table: None, labels, objects: vec![ball], rest_visible: false, own_values: false };
     let s = scene(&data, unshaded(Mode::Dvr), Some(seg));
     let hit = pixel(&s, -8.0, 0.0);
     assert!(close(hit.w, 1.0, 1e-6), "{hit}");
@@ -242,7 +249,7 @@ fn scene_files_name_labels_and_report_typos() {
 fn picking_names_the_label_of_a_segmented_volume() {
     let (data, labels) = phantom();
     let ball = object("ball", vec![1], Mode::Dvr);
-    let seg = Segmentation { table: None, labels, objects: vec![ball], rest_visible: true };
+    let seg = Segmentation { table: None, labels, objects: vec![ball], rest_visible: true, own_values: false };
     // The rest opaque from value 55: the plate stops a pick.
     let mut opaque = ramp();
     opaque.opacity = vec![OpacityPoint(0.0, 0.0), OpacityPoint(50.0, 0.0), OpacityPoint(55.0, 1.0)];
@@ -292,7 +299,7 @@ fn empty_bricks_are_those_where_no_part_draws() {
     let plain = a.brick_occupancy(&data).unwrap();
     let alike = vec![Object::new("ball", vec![1], a.clone()), Object::new("cube", vec![2, 3], a.clone())];
     let segmented = |objects: Vec<Object>, rest_visible: bool| Appearance {
-        segmentation: Some(Segmentation { table: None, labels: labels.clone(), objects, rest_visible }),
+        segmentation: Some(Segmentation { table: None, labels: labels.clone(), objects, rest_visible, own_values: false }),
         ..a.clone()
     };
     let count = |o: &[bool]| o.iter().filter(|b| **b).count();
@@ -320,4 +327,44 @@ fn empty_bricks_are_those_where_no_part_draws() {
     let (mip, dvr) = (with(Mode::Mip), with(Mode::Dvr));
     assert!(mip[at(8.0, 0.0, 0.0)] && !dvr[at(8.0, 0.0, 0.0)]);
     assert_eq!(count(&dvr), 0);
+}
+
+/// A ball of 200 (label 1) in a field of 20 (label 0), on one 32³ grid.
+fn ball_in_a_field() -> (Arc<Volume>, Arc<Volume>) {
+    let c = (N as f32 - 1.0) * 0.5;
+    let inside = |i: u32| (Vec3::new((i % N) as f32, (i / N % N) as f32, (i / (N * N)) as f32) - Vec3::splat(c)).length() < 8.0;
+    let grid = Grid::centered(UVec3::splat(N), Vec3::ONE);
+    let volume = |name: &str, codes: Vec<u8>| {
+        Arc::new(Volume::new(name, grid.clone(), Voxels::U8(codes), ValueMap::IDENTITY, Source::default()).unwrap())
+    };
+    let data = (0..N * N * N).map(|i| if inside(i) { 200 } else { 20 }).collect();
+    let labels = (0..N * N * N).map(|i| u8::from(inside(i))).collect();
+    (volume("data", data), volume("labels", labels))
+}
+
+#[test]
+fn no_objects_values_bleed_into_the_rest_beside_it() {
+    // The ball hidden, the rest drawn opaque above 100: a value no voxel of the rest has,
+    // so nothing may be drawn. Plain trilinear samples of the rest next to the ball mix
+    // in its 200s (half a voxel out: 110), the rim two-level rendering must not draw;
+    // each part's samples come from its own label's voxels.
+    let (data, labels) = ball_in_a_field();
+    let above_100 =
+        TransferFunction { opacity: vec![OpacityPoint(0.0, 0.0), OpacityPoint(100.0, 0.0), OpacityPoint(101.0, 1.0)], ..ramp() };
+    let rest =
+        Appearance { shading: focal::region::Shading { enabled: false, ..Default::default() }, ..Appearance::new(Mode::Dvr, above_100) };
+    let hidden = Object { visible: false, ..object("ball", vec![1], Mode::Dvr) };
+    let seg = Segmentation { labels, table: None, objects: vec![hidden], rest_visible: true, own_values: true };
+    let segmented = scene(&data, rest.clone(), Some(seg));
+    let plain = scene(&data, rest, None);
+    let mut rim = 0.0f32;
+    for y in -10..=10 {
+        for x in -10..=10 {
+            let (x, y) = (x as f32 + 0.25, y as f32 - 0.35);
+            rim = rim.max(pixel(&segmented, x, y).w);
+        }
+    }
+    assert!(rim < 1e-6, "the rest draws a rim of opacity {rim} beside the hidden ball");
+    // (The look itself draws the ball: the test can tell.)
+    assert!(pixel(&plain, 0.25, -0.35).w > 0.5);
 }

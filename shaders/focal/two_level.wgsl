@@ -4,11 +4,14 @@
 // trace::Gathered): the segment of a segmented region the ray is in, what it has
 // gathered, and one sample of it by its part's mode.
 
-#import focal::types::{Region, MODE_ISO, MODE_OFF}
-#import focal::bindings::{scene, regions}
+#import focal::types::{Region, MODE_ISO, MODE_OFF, REGION_ON_GRID, REGION_OCCUPANCY}
+#import focal::bindings::{scene, regions, occupancy}
 #import focal::camera::Ray
 #import focal::regions::to_voxel
-#import focal::sampling::{lut_texel, trilinear, nearest_code, count_sample}
+#import focal::sampling::{lut_texel, trilinear, trilinear_box, nearest_code, count_sample, at_full_resolution, brick_of}
+#ifdef HAS_BRICKED
+#import focal::bricked::{is_bricked, level_zero}
+#endif
 #import focal::transfer::classify
 #import focal::compositing::composite
 #import focal::segments::{DONE, HAS_PREV}
@@ -59,6 +62,95 @@ fn part_of(r: Region, labels: Region, p: vec3<f32>, v: f32) -> u32 {
     return rest;
 }
 
+// The class of label code `code` (twolevel::code_classes: codes of the same objects),
+// from the texels after the label record's candidates.
+fn code_class(labels: Region, code: u32) -> u32 {
+    if code >= labels.lut_width {
+        return 0xffffu;
+    }
+    return u32(lut_texel(labels.lut_offset + labels.lut_width + code, scene.lut_atlas_width).x + 0.5);
+}
+
+// Whether the cell of label voxel q may hold more than one class: its brick's bit in
+// the label record's occupancy (render::pack, twolevel::boundary_bricks).
+fn boundary_brick(labels: Region, q: vec3<f32>) -> bool {
+    if (labels.flags & REGION_OCCUPANCY) == 0u {
+        return true;
+    }
+    let b = brick_of(labels, q);
+    let i = (b.z * labels.bricks.y + b.y) * labels.bricks.x + b.x;
+    return ((occupancy[labels.occupancy_offset + i / 32u] >> (i % 32u)) & 1u) != 0u;
+}
+
+// The value of a sample of segmented region r at data voxel q (plain trilinear value v)
+// from the voxels of its own label alone (reference: PreparedObjects::own_value): the
+// trilinear weights of the cell's eight voxels renormalised over those with the label
+// of q's nearest voxel, so no other object's values bleed into this one's beside their
+// boundary. v where the cell holds one label, the labels are not on the data's grid
+// (REGION_ON_GRID; for bricked data, on level 0's: the cell is level 0's), or the
+// sample is from a mip level. The eight labels first: their values only at a boundary.
+fn own_value(r: Region, labels: Region, q: vec3<f32>, v: f32) -> f32 {
+#ifndef OWN_VALUES
+    return v;
+#else
+    if (r.flags & REGION_ON_GRID) == 0u || !at_full_resolution() {
+        return v;
+    }
+    var qi = q;
+#ifdef HAS_BRICKED
+    if is_bricked(r) {
+        qi = level_zero(r, q);
+    }
+#endif
+    if !boundary_brick(labels, qi) {
+        return v;
+    }
+    let own_code = nearest_code(labels, qi);
+    let own_class = code_class(labels, own_code);
+    let last = labels.dims.xyz - 1.0;
+    let base = floor(qi);
+    let f = qi - base;
+    var mine = 0u;
+    for (var i = 0u; i < 8u; i++) {
+        let o = vec3<f32>(f32(i & 1u), f32((i >> 1u) & 1u), f32((i >> 2u) & 1u));
+        let code = nearest_code(labels, clamp(base + o, vec3(0.0), last));
+        // (The class's texel only where the code differs.)
+        if code == own_code || code_class(labels, code) == own_class {
+            mine |= 1u << i;
+        }
+    }
+    if mine == 255u || mine == 0u {
+        return v;
+    }
+    var sum = 0.0;
+    var weights = 0.0;
+    for (var i = 0u; i < 8u; i++) {
+        if (mine & (1u << i)) == 0u {
+            continue;
+        }
+        let o = vec3<f32>(f32(i & 1u), f32((i >> 1u) & 1u), f32((i >> 2u) & 1u));
+        let c = clamp(base + o, vec3(0.0), last);
+        let w3 = abs(1.0 - o - f + 2.0 * o * f);
+        let w = w3.x * w3.y * w3.z;
+        var value = 0.0;
+#ifdef HAS_BRICKED
+        if is_bricked(r) {
+            // (Level-0 voxel c as the region's coarse index: its centre, exact where its
+            // level-0 brick is resident.)
+            value = trilinear(r, (c + 0.5) / r.bricked_scale.x - 0.5);
+        } else {
+            value = trilinear_box(r.atlas_offset.xyz, r.dims.xyz, c);
+        }
+#else
+        value = trilinear_box(r.atlas_offset.xyz, r.dims.xyz, c);
+#endif
+        sum += w * value;
+        weights += w;
+    }
+    return select(v, sum / weights, weights > 0.0);
+#endif
+}
+
 // Ends the open segment, whose part record is `part`: a projection part emits its value
 // as one sample (reference: trace::close).
 fn close_segment(r: Region, part: Region, open: ptr<function, Open>, acc: vec4<f32>) -> vec4<f32> {
@@ -99,10 +191,11 @@ fn two_level_sample(r: Region, labels: Region, part: ptr<function, Region>, open
     }
 #ifdef HAS_PROJECTION
     if is_projection((*part).mode) {
-        if projection_takes(*part, v) {
-            (*open).max = max((*open).max, v);
-            (*open).min = min((*open).min, v);
-            (*open).sum += v;
+        let own = own_value(r, labels, q, v);
+        if projection_takes(*part, own) {
+            (*open).max = max((*open).max, own);
+            (*open).min = min((*open).min, own);
+            (*open).sum += own;
             (*open).count++;
         }
         return out;
@@ -127,7 +220,8 @@ fn two_level_sample(r: Region, labels: Region, part: ptr<function, Region>, open
     }
 #endif
 #ifdef HAS_DVR
-    out = dvr_classified(*part, q, v, classify(*part, v, scene.lut_atlas_width), 1.0, ratio, ray, t, out);
+    let own = own_value(r, labels, q, v);
+    out = dvr_classified(*part, q, own, classify(*part, own, scene.lut_atlas_width), 1.0, ratio, ray, t, out);
 #endif
     return out;
 }

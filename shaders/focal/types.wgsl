@@ -109,6 +109,8 @@ const REGION_SELECTION: u32 = 16u;
 const REGION_KEEP_UNSELECTED: u32 = 32u;
 // Another region is drawn in this one's samples (record: objects.z; render::pack::companions).
 const REGION_COMPANION: u32 = 64u;
+// A segmented region whose labels lie on its data's grid (two_level::own_value).
+const REGION_ON_GRID: u32 = 128u;
 
 const VIEW_JITTER: u32 = 1u;
 const VIEW_SKIP_EMPTY: u32 = 2u;

@@ -108,6 +108,14 @@ pub struct PreparedObjects<'a> {
     pub parts: Vec<PreparedRegion<'a>>,
     /// Per part: whether it draws.
     pub visible: Vec<bool>,
+    /// `Segmentation::own_values` asked for, and the label volume lies on the data's
+    /// grid (voxel for voxel): boundaries are sampled from each object's own voxels
+    /// ([`Self::own_value`]).
+    pub on_grid: bool,
+    /// `Segmentation::own_values` (for bricked data the GPU checks level 0's grid).
+    pub own_values: bool,
+    /// Each label code's class (`twolevel::code_classes`): codes of the same objects.
+    pub classes: Vec<u16>,
 }
 
 impl PreparedObjects<'_> {
@@ -116,6 +124,37 @@ impl PreparedObjects<'_> {
     pub fn part_at(&self, q: Vec3, v: f32) -> usize {
         let code = self.labels.nearest(self.data_to_label.transform_point3(q));
         self.table.object(code, v).unwrap_or(self.parts.len() - 1)
+    }
+
+    /// The value of a sample at data voxel `q` (plain trilinear value `v`, from `data`)
+    /// taken from the voxels of its own label class alone (`twolevel::code_classes`:
+    /// labels of the same objects): the trilinear weights of the cell's eight voxels
+    /// renormalised over those whose class is the sample's, so near
+    /// a boundary no other object's values bleed into this one's (a bone value into the
+    /// soft tissue beside a skull drawn as another object: a rim). `v` where the cell
+    /// holds one label, or the labels are not on the data's grid.
+    pub fn own_value(&self, data: &VolumeSampler, q: Vec3, v: f32) -> f32 {
+        if !self.on_grid {
+            return v;
+        }
+        let class = |code: u16| self.classes.get(code as usize).copied().unwrap_or(u16::MAX);
+        let code = class(self.labels.nearest(q));
+        let last = self.label_volume.dims().as_vec3() - 1.0;
+        let base = q.floor();
+        let f = q - base;
+        let (mut sum, mut weights, mut one_label) = (0.0f32, 0.0f32, true);
+        for i in 0..8u32 {
+            let o = Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32);
+            let c = (base + o).clamp(Vec3::ZERO, last);
+            let w = (Vec3::ONE - o - f + 2.0 * o * f).abs().element_product();
+            if class(self.labels.nearest(c)) == code {
+                sum += w * data.trilinear(c);
+                weights += w;
+            } else {
+                one_label = false;
+            }
+        }
+        if one_label || weights <= 0.0 { v } else { sum / weights }
     }
 }
 
@@ -135,6 +174,14 @@ impl<'a> PreparedRegion<'a> {
                 data_to_label: seg.data_to_label(&volume.grid),
                 parts,
                 visible,
+                on_grid: seg.own_values
+                    && seg.labels.dims() == volume.dims()
+                    && seg.data_to_label(&volume.grid).abs_diff_eq(Affine3A::IDENTITY, 1e-4),
+                own_values: seg.own_values,
+                classes: {
+                    let table = seg.table(volume);
+                    crate::twolevel::code_classes(&table, table.candidates.len())
+                },
             });
         }
         p

@@ -115,6 +115,9 @@ struct SamplePoint {
     q: Vec3,
     t: f32,
     region: usize,
+    /// The sample's value where it is not the plain trilinear one (a two-level part's
+    /// own value at a boundary, `PreparedObjects::own_value`).
+    value: Option<f32>,
 }
 
 /// Traces one ray. `jitter` ∈ [0, 1) offsets the samples; `depth_threshold` is the
@@ -186,12 +189,13 @@ pub fn trace_antialiased(
             let q = r.region.world_to_voxel.transform_point3(p);
             match &r.objects {
                 None => {
-                    sample(&mut out, r, &mut st.gathered, st.ratio, SamplePoint { q, t, region: i }, &at);
+                    sample(&mut out, r, &mut st.gathered, st.ratio, SamplePoint { q, t, region: i, value: None }, &at);
                     st.done = st.gathered.done;
                 }
                 Some(objects) => {
                     // Two-level: a new segment starts where the object changes.
-                    let part = objects.part_at(q, r.sample(q, at.level));
+                    let v = r.sample(q, at.level);
+                    let part = objects.part_at(q, v);
                     if st.part != Some(part) {
                         close(&mut out, r, st, t, i, depth_threshold);
                         st.part = Some(part);
@@ -206,7 +210,9 @@ pub fn trace_antialiased(
                         iso_surface(&mut out, shown, q, t, i, &at);
                         st.gathered.done = true;
                     } else {
-                        sample(&mut out, shown, &mut st.gathered, st.ratio, SamplePoint { q, t, region: i }, &at);
+                        // (Boundaries at full resolution: a mip level blends neighbours anyway.)
+                        let own = if at.level <= 0.0 { objects.own_value(&r.sampler, q, v) } else { v };
+                        sample(&mut out, shown, &mut st.gathered, st.ratio, SamplePoint { q, t, region: i, value: Some(own) }, &at);
                     }
                 }
             }
@@ -229,13 +235,13 @@ pub fn trace_antialiased(
 /// `q`, ray parameter `t`: composited at once (DVR modes), gathered (projections) or
 /// tested for a crossing (iso-surfaces).
 fn sample(out: &mut Traced, r: &PreparedRegion, g: &mut Gathered, ratio: f32, p: SamplePoint, at: &Sampling) {
-    let SamplePoint { q, t, region: i } = p;
+    let SamplePoint { q, t, region: i, value } = p;
     let (ray, light, level, depth_threshold) = (at.ray, at.light, at.level, at.depth_threshold);
     let view = ray.dir;
     match r.mode {
         Mode::Mip | Mode::MinIp | Mode::XRay => {
             out.classified += 1;
-            let v = r.sample(q, level);
+            let v = value.unwrap_or_else(|| r.sample(q, level));
             if !(r.projection.0..=r.projection.1).contains(&v) {
                 return;
             }
@@ -250,7 +256,7 @@ fn sample(out: &mut Traced, r: &PreparedRegion, g: &mut Gathered, ratio: f32, p:
                 return;
             }
             out.classified += 1;
-            let v = r.sample(q, level);
+            let v = value.unwrap_or_else(|| r.sample(q, level));
             let rgba = r.lookup.classify(v, r.sampler.nearest(q));
             let a = r.weight.as_ref().map_or(rgba[3], |w| rgba[3] * w.at(q));
             if a <= 0.0 {

@@ -331,12 +331,19 @@ pub struct Segmentation {
     pub objects: Vec<Object>,
     /// Whether samples in no object are drawn (with the data volume's own appearance).
     pub rest_visible: bool,
+    /// Each sample's value from its own object's voxels where a cell straddles objects
+    /// (no rim of one object's values around another: `twolevel`, "Object boundaries");
+    /// labels on the data's grid only. Costs the cell's labels at every boundary sample.
+    pub own_values: bool,
 }
 
 /// Equal when they use the same label volume (the same shared data) the same way.
 impl PartialEq for Segmentation {
     fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.labels, &other.labels) && self.objects == other.objects && self.rest_visible == other.rest_visible
+        Arc::ptr_eq(&self.labels, &other.labels)
+            && self.objects == other.objects
+            && self.rest_visible == other.rest_visible
+            && self.own_values == other.own_values
     }
 }
 
@@ -578,6 +585,7 @@ mod tests {
                 object("anything dark", vec![], Some((0.0, 50.0))),
             ],
             rest_visible: true,
+            own_values: false,
         };
         seg.validate().unwrap();
         // The data volume maps codes 0…255 to themselves, normalised by 255.
@@ -604,6 +612,7 @@ mod tests {
             labels: labels(vec![0, 1]),
             objects: vec![object("a", vec![1], Some((5.0, 1.0)))],
             rest_visible: true,
+            own_values: false,
         };
         assert!(seg.validate().unwrap_err().contains("object 'a'"));
         seg.objects = (0..5).map(|i| object(&format!("o{i}"), vec![1], None)).collect();
@@ -622,7 +631,7 @@ mod tests {
     fn label_voxels_follow_the_data_grid() {
         // Labels at half the resolution of the data, same world box origin.
         let data = Grid::new(UVec3::new(8, 8, 8), Vec3::ONE);
-        let seg = Segmentation { table: None, labels: Arc::new(phantom_labels()), objects: vec![], rest_visible: true };
+        let seg = Segmentation { table: None, labels: Arc::new(phantom_labels()), objects: vec![], rest_visible: true, own_values: false };
         let m = seg.data_to_label(&data);
         assert!((m.transform_point3(Vec3::new(6.0, 2.0, 4.0)) - Vec3::new(3.0, 1.0, 2.0)).length() < 1e-6);
     }

@@ -77,6 +77,10 @@ pub struct SegmentationSpec {
     /// Whether samples in no object are drawn.
     #[serde(default = "yes")]
     pub rest_visible: bool,
+    /// Each sample's value from its own object's voxels at boundaries (no rims;
+    /// `Segmentation::own_values`).
+    #[serde(default)]
+    pub own_values: bool,
 }
 
 /// One object of a segmentation.

@@ -45,6 +45,12 @@ pub mod region_flags {
     /// Another region is drawn in this one's samples (its record: `objects.z`;
     /// `render::pack::companions`).
     pub const COMPANION: u32 = 64;
+    /// A segmented region whose label volume lies on its data's grid: each part's
+    /// samples come from its own label's voxels (`two_level.wgsl` own_value).
+    pub const ON_GRID: u32 = 128;
+    /// A segmented region asks for [`ON_GRID`]'s boundaries (`Segmentation::own_values`;
+    /// given where its labels lie on the grid: bricked data on level 0's).
+    pub const OWN_VALUES: u32 = 256;
 }
 
 /// Scene features: which parts of the shader a scene needs (shader defs).
@@ -83,9 +89,12 @@ pub mod features {
     /// (`render::bricked`): every sample reads the atlas, and the paths to the volume
     /// atlas, which llvmpipe ran beside the atlas's for every sample, are left out.
     pub const BRICKED_ONLY: u32 = 131072;
+    /// A segmented region takes each sample's value from its own object's voxels at
+    /// boundaries (`region_flags::ON_GRID`).
+    pub const OWN_VALUES: u32 = 262144;
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 18] = [
+    pub const NAMES: [(u32, &str); 19] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -104,6 +113,7 @@ pub mod features {
         (COMPANION, "COMPANION"),
         (BRICKED, "HAS_BRICKED"),
         (BRICKED_ONLY, "BRICKED_ONLY"),
+        (OWN_VALUES, "OWN_VALUES"),
     ];
 }
 

@@ -129,8 +129,14 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         slots_of[i] = Some(out.regions.len() as u32);
         let levels = out.levels[slots[0]].clone();
         let mut region = pack_region(p, &levels, out.brick_atlas.offsets[slots[0]], &mut out);
-        if p.objects.is_some() {
+        if let Some(objects) = &p.objects {
             region.mode = mode::TWO_LEVEL;
+            if objects.on_grid {
+                region.flags |= region_flags::ON_GRID;
+            }
+            if objects.own_values {
+                region.flags |= region_flags::OWN_VALUES;
+            }
             segmented.push((out.regions.len(), p, slots.clone()));
         }
         if let Some(w) = &p.weight {
@@ -212,11 +218,25 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
     let lut_offset = out.lut.len() as u32;
     out.lut.extend(objects.table.candidates.iter().map(|c| c.map(|k| k as f32)));
     let world_to_labels = objects.data_to_label * p.region.world_to_voxel;
+    // Each code's class after its candidates (`twolevel::code_classes`), and where a
+    // cell may straddle classes (`twolevel::class_boundary_bricks`) as the occupancy bits
+    // of the label record over its own bricks.
+    out.lut.extend(objects.classes.iter().map(|&c| [c as f32, 0.0, 0.0, 0.0]));
+    let (bricks, boundary) = crate::twolevel::class_boundary_bricks(labels, &objects.table);
+    let occupancy_offset = out.occupancy.len() as u32;
+    let mut words = vec![0u32; boundary.len().div_ceil(32)];
+    for (i, _) in boundary.iter().enumerate().filter(|(_, b)| **b) {
+        words[i / 32] |= 1 << (i % 32);
+    }
+    out.occupancy.extend(words);
     out.regions.push(GpuRegion {
         world_to_voxel: Mat4::from(world_to_labels),
         dims: labels.dims().as_vec3().extend(labels.code_max() as f32),
         atlas_offset: out.levels[label_slot][0].as_vec3().extend(0.0),
         mode: mode::OFF,
+        flags: region_flags::OCCUPANCY,
+        bricks,
+        occupancy_offset,
         lut_offset,
         lut_width: objects.table.candidates.len() as u32,
         ..Default::default()
@@ -348,6 +368,9 @@ pub fn scene_features(regions: &[GpuRegion], overlaps: Overlaps) -> u32 {
         }
         if r.hole_count > 0 {
             bits |= f::HOLES;
+        }
+        if r.flags & region_flags::ON_GRID != 0 {
+            bits |= f::OWN_VALUES;
         }
         // (Weights act on DVR samples only: with DVR in the shader.)
         if r.flags & region_flags::SELECTION != 0 && bits & f::DVR != 0 {

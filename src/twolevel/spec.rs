@@ -29,6 +29,7 @@ pub fn segmentation(spec: &SegmentationSpec, labels: LabelSource, data: &Volume,
         labels: labels.volume.clone(),
         objects,
         rest_visible: spec.rest_visible,
+        own_values: spec.own_values,
     };
     seg.validate()?;
     Ok(seg)
@@ -86,5 +87,5 @@ pub fn segmentation_spec(seg: &Segmentation, labels: usize) -> SegmentationSpec 
             appearance: AppearanceSpec::of(&o.appearance, None),
         })
         .collect();
-    SegmentationSpec { labels, objects, rest_visible: seg.rest_visible }
+    SegmentationSpec { labels, objects, rest_visible: seg.rest_visible, own_values: seg.own_values }
 }

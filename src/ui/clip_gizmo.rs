@@ -263,7 +263,7 @@ mod tests {
     /// Presses the left button at `from`, drags to `to` over a few frames, releases.
     fn drag(world: &mut World, from: Vec2, to: Vec2) {
         use bevy::ecs::system::RunSystemOnce;
-        let mut set_cursor = |world: &mut World, at: Vec2| {
+        let set_cursor = |world: &mut World, at: Vec2| {
             let mut q = world.query_filtered::<&mut Window, With<PrimaryWindow>>();
             for mut w in q.iter_mut(world) {
                 w.set_cursor_position(Some(at));

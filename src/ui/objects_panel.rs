@@ -39,8 +39,13 @@ pub fn panel(ui: &mut Ui, data: &Volume, segmentation: &mut Option<Segmentation>
         }
         for s in sources {
             if ui.button(format!("Segment with {}", s.name)).clicked() {
-                *segmentation =
-                    Some(Segmentation { labels: s.volume.clone(), table: s.table.clone(), objects: Vec::new(), rest_visible: true });
+                *segmentation = Some(Segmentation {
+                    labels: s.volume.clone(),
+                    table: s.table.clone(),
+                    objects: Vec::new(),
+                    rest_visible: true,
+                    own_values: false,
+                });
                 *sel.editing = None;
             }
         }
@@ -56,6 +61,10 @@ pub fn panel(ui: &mut Ui, data: &Volume, segmentation: &mut Option<Segmentation>
     } else {
         ui.label(RichText::new("double-click the view to pick a label, or choose one below").small().weak());
     }
+    ui.checkbox(&mut seg.own_values, "no rims at object boundaries").on_hover_text(
+        "Each sample's value from its own object's voxels where objects meet (labels on the data's grid); \
+         slower in software rendering",
+    );
     egui::CollapsingHeader::new("labels").default_open(false).show(ui, |ui| label_list(ui, data, seg, sel.editing));
     let mut remove = None;
     for (k, o) in seg.objects.iter_mut().enumerate() {

@@ -200,8 +200,8 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             context: ContextParams { kappa_t: 3.0, ..Default::default() },
             ..Appearance::new(Mode::Context, presets::builtin("ct_skin_bone")?)
         };
-        let segmented = |objects: Vec<Object>| Appearance {
-            segmentation: Some(Segmentation { labels: labels.clone(), table: None, objects, rest_visible: true }),
+        let segmented = |objects: Vec<Object>, own_values: bool| Appearance {
+            segmentation: Some(Segmentation { labels: labels.clone(), table: None, objects, rest_visible: true, own_values }),
             ..rest.clone()
         };
         use focal::volume::phantom::head::label;
@@ -215,8 +215,10 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
             Object::new("skull", vec![label::SKULL as u32], Appearance::new(Mode::Mip, presets::builtin("grayscale_ramp")?)),
             Object::new("ventricles", vec![label::VENTRICLES as u32], Appearance::new(Mode::XRay, presets::builtin("grayscale_ramp")?)),
         ];
-        let names = ["context (no objects)", "two-level, objects alike", "two-level, dvr + mip + xray"];
-        let appearances = [rest.clone(), segmented(alike), segmented(objects)];
+        // (With own values each sample near a boundary takes its value from its own
+        // object's voxels: the cell's eight labels at every boundary sample.)
+        let names = ["context (no objects)", "two-level, objects alike", "two-level, dvr + mip + xray", "two-level, own values"];
+        let appearances = [rest.clone(), segmented(alike, false), segmented(objects.clone(), false), segmented(objects, true)];
         let (ms, images) = bench.interleaved_appearances(ct, &appearances, still)?;
         let note = format!("objects alike differ from no objects by at most {} levels", difference(&images[0], &images[1]));
         push_group(&mut rows, &bench, "twolevel", &names, &ms, "head phantom", &note);

@@ -5,11 +5,11 @@
 //! magnifier may step at level 0). Where every record is bricked the scene may take the
 //! `BRICKED_ONLY` shader (once the atlas holds every coarse brick: [`pipeline_features`]).
 
-use glam::{UVec4, Vec4};
+use glam::{Mat4, UVec4, Vec3, Vec4};
 
 use super::page_table::directory_level;
 use crate::region::RenderScene;
-use crate::render::gpu_types::features;
+use crate::render::gpu_types::{GpuRegion, features, mode, region_flags};
 use crate::render::pack::PackedScene;
 use crate::streaming::bricked::BrickFrame;
 
@@ -31,11 +31,32 @@ pub fn mark_bricked(packed: &mut PackedScene, scene: &RenderScene, frames: &[Opt
         let Some(level0) = frame.table_dims.first().copied() else { continue };
         let directory_level = directory_level(frame.table_dims.len() - 1);
         let mut any = false;
-        for r in packed.regions.iter_mut().filter(|r| r.atlas_offset.truncate() == offset && r.dims.truncate() == dims) {
+        let mut own_values = false;
+        // A segmented region's labels on level 0's grid: each part's samples come from
+        // its own label's level-0 voxels (`region_flags::ON_GRID`).
+        let on_level0 = |r: &GpuRegion, labels: Option<&GpuRegion>| {
+            let to_level0 =
+                Mat4::from_translation(Vec3::splat(0.5 * (scale - 1.0))) * Mat4::from_scale(Vec3::splat(scale)) * r.world_to_voxel;
+            labels.is_some_and(|l| l.dims.truncate() == level0.as_vec3() && l.world_to_voxel.abs_diff_eq(to_level0, 1e-3))
+        };
+        for i in 0..packed.regions.len() {
+            let r = packed.regions[i];
+            if r.atlas_offset.truncate() != offset || r.dims.truncate() != dims {
+                continue;
+            }
+            let on_grid = r.mode == mode::TWO_LEVEL
+                && r.flags & region_flags::OWN_VALUES != 0
+                && on_level0(&r, packed.regions.get(r.objects.z as usize));
+            let r = &mut packed.regions[i];
             r.bricked = UVec4::new(entry, frame.layout.size, frame.layout.apron, frame.coarse as u32);
             r.bricked_scale = Vec4::new(scale, volume.grid.min_spacing() / scale, 0.0, 0.0);
             r.bricked_dims = level0.extend(directory_level as u32);
+            r.flags = if on_grid { r.flags | region_flags::ON_GRID } else { r.flags & !region_flags::ON_GRID };
+            own_values |= on_grid;
             any = true;
+        }
+        if own_values {
+            packed.features |= features::OWN_VALUES;
         }
         if any {
             directory.push(v);
