@@ -53,7 +53,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 18] = [
+const DEFS: [&str; 19] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -72,6 +72,7 @@ const DEFS: [&str; 18] = [
     "COMPANION",
     "HAS_BRICKED",
     "BRICKED_ONLY",
+    "OWN_VALUES",
 ];
 
 #[test]
@@ -100,6 +101,15 @@ fn every_shader_variant_composes_and_validates() {
     let all_but_holes = ((1u32 << DEFS.len()) - 1) & !bricked & !bit("HAS_HOLES");
     let possible =
         |bits: u32| possible(bits) && (bits & bricked == 0 || (bits & !bricked).count_ones() <= 2 || bits & !bricked == all_but_holes);
+    // Own values at object boundaries sit in the two-level code alone: with it and up to
+    // two other defs, and with all of them.
+    let own = bit("OWN_VALUES");
+    let full = (1u32 << DEFS.len()) - 1;
+    let possible = |bits: u32| {
+        possible(bits)
+            && (bits & own == 0
+                || (bits & bit("HAS_TWO_LEVEL") != 0 && ((bits & !own).count_ones() <= 3 || (bits | bricked | bit("HAS_HOLES")) == full)))
+    };
     for bits in (0u32..(1 << DEFS.len())).filter(|b| possible(*b)) {
         let defs: HashMap<String, ShaderDefValue> = DEFS
             .iter()

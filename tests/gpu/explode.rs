@@ -108,18 +108,16 @@ fn exploded_halves(gpu: &mut Gpu, carried: bool) {
     gpu.clear();
 }
 
-/// 18 parts (a 3×3×2 grid) exploded: the ray tests them in runs of
-/// `render::gpu_types::CLUSTER` (8, 8 and 2, with the selection's region) behind the
-/// sphere around each run; every part must still be drawn where the reference draws it.
-pub fn eighteen_exploded_parts_match_the_reference(gpu: &mut Gpu) {
+/// The head with `look`, exploded around the arteries into 18 parts (a 3×3×2 grid) at
+/// rest and framed obliquely: the dataset and the camera.
+fn eighteen_parts(gpu: &mut Gpu, look: Appearance) -> (Entity, FocalCamera) {
     let ct = head();
-    let skin = Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap());
     gpu.clear();
     let labels = phantom::head::generate(64).unwrap().labels;
     let ids = [phantom::head::label::ARTERIES as u32].into_iter().collect();
     let selection = SelectionVolume::from_labels(&labels, &ids).unwrap();
     let world = gpu.off.world_mut();
-    let data = world.spawn((Dataset::new(ct.clone(), skin), Transform::default(), Exploded::around(&selection))).id();
+    let data = world.spawn((Dataset::new(ct.clone(), look), Transform::default(), Exploded::around(&selection))).id();
     use focal::explode::spec::{ExplodeSpec, PartsSpec, SelectionSpec};
     let grid = ExplodeSpec { parts: PartsSpec::Grid((3, 3, 2)), ..ExplodeSpec::around(SelectionSpec::Nothing) }.parts(&ct).unwrap();
     assert_eq!(grid.len(), 18);
@@ -128,46 +126,42 @@ pub fn eighteen_exploded_parts_match_the_reference(gpu: &mut Gpu) {
     }
     let cam = framed(&ct, View::Oblique, true);
     gpu.off.set_camera(&cam);
-    // (A frame first: the parts get their bodies.)
-    gpu.off.capture().unwrap();
+    (data, cam)
+}
+
+/// The picture now against the reference of the same regions (at least `regions`).
+fn matches_its_reference(gpu: &mut Gpu, name: &str, cam: &FocalCamera, regions: usize) {
+    let img = gpu.off.capture().unwrap();
+    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
+    assert!(scene.regions.len() >= regions, "{name}: {} regions, not {regions}", scene.regions.len());
+    assert_matches(name, &img, &render(&scene, cam, SIZE, SIZE).unwrap().to_image().unwrap());
+}
+
+/// Pushes the parts of `data` apart (degree 1, 300 steps).
+fn push_apart(gpu: &mut Gpu, data: Entity) {
     gpu.off.world_mut().get_mut::<Exploded>(data).unwrap().coefficients.degree = 1.0;
     step(gpu.off.world_mut(), 300);
-    let apart = gpu.off.capture().unwrap();
-    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
-    assert!(scene.regions.len() >= 19, "{} regions: the parts apart, each its own", scene.regions.len());
-    assert_matches("eighteen_parts_apart", &apart, &render(&scene, &cam, SIZE, SIZE).unwrap().to_image().unwrap());
+}
+
+/// 18 parts (a 3×3×2 grid) exploded: the ray tests them in runs of
+/// `render::gpu_types::CLUSTER` (8, 8 and 2, with the selection's region) behind the
+/// sphere around each run; every part must still be drawn where the reference draws it.
+pub fn eighteen_exploded_parts_match_the_reference(gpu: &mut Gpu) {
+    let (data, cam) = eighteen_parts(gpu, Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap()));
+    // (A frame first: the parts get their bodies.)
+    gpu.off.capture().unwrap();
+    push_apart(gpu, data);
+    matches_its_reference(gpu, "eighteen_parts_apart", &cam, 19);
     gpu.clear();
 }
 
 /// A MIP of an exploded view is one maximum along the whole ray (not each part's maximum
-/// composited over the next): 18 parts around the arteries, at rest and pushed apart,
-/// against the reference.
+/// composited over the next): the 18 parts, at rest and pushed apart, against the
+/// reference. (Parts that move alike draw as one region; pushed apart each is its own.)
 pub fn a_mip_of_exploded_parts_is_one_maximum_along_the_ray(gpu: &mut Gpu) {
-    let ct = head();
-    let mip = Appearance::new(Mode::Mip, presets::builtin("grayscale_ramp").unwrap());
-    let cam = framed(&ct, View::Oblique, true);
-    gpu.clear();
-    let world = gpu.off.world_mut();
-    // (Parts that move alike draw as one region: the explosion around a selection, the
-    // arteries, pushes them apart into regions of their own.)
-    let labels = phantom::head::generate(64).unwrap().labels;
-    let ids = [phantom::head::label::ARTERIES as u32].into_iter().collect();
-    let selection = SelectionVolume::from_labels(&labels, &ids).unwrap();
-    let data = world.spawn((Dataset::new(ct.clone(), mip), Transform::default(), Exploded::around(&selection))).id();
-    use focal::explode::spec::{ExplodeSpec, PartsSpec, SelectionSpec};
-    let grid = ExplodeSpec { parts: PartsSpec::Grid((3, 3, 2)), ..ExplodeSpec::around(SelectionSpec::Nothing) }.parts(&ct).unwrap();
-    for rest in grid {
-        spawn_part(world, Part::new(data, rest), Transform::default());
-    }
-    gpu.off.set_camera(&cam);
-    let at_rest = gpu.off.capture().unwrap();
-    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
-    assert_matches("mip_parts_at_rest", &at_rest, &render(&scene, &cam, SIZE, SIZE).unwrap().to_image().unwrap());
-    gpu.off.world_mut().get_mut::<Exploded>(data).unwrap().coefficients.degree = 1.0;
-    step(gpu.off.world_mut(), 300);
-    let apart = gpu.off.capture().unwrap();
-    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
-    assert!(scene.regions.len() >= 18, "{} regions", scene.regions.len());
-    assert_matches("mip_parts_apart", &apart, &render(&scene, &cam, SIZE, SIZE).unwrap().to_image().unwrap());
+    let (data, cam) = eighteen_parts(gpu, Appearance::new(Mode::Mip, presets::builtin("grayscale_ramp").unwrap()));
+    matches_its_reference(gpu, "mip_parts_at_rest", &cam, 1);
+    push_apart(gpu, data);
+    matches_its_reference(gpu, "mip_parts_apart", &cam, 18);
     gpu.clear();
 }
