@@ -295,7 +295,7 @@ mod tests {
         let before = shown(&mut world, e);
         // The handle, dragged 3 mm along the normal's screen direction: x = 7.
         drag(&mut world, before.handle, before.handle + before.per_mm * 3.0);
-        let plane = world.get::<Dataset>(e).unwrap().clip.planes[0].clone();
+        let plane = world.get::<Dataset>(e).unwrap().clip.planes[0];
         assert!((plane.point.x - 7.0).abs() < 0.05 && plane.normal == Vec3::X, "{plane:?}");
         assert!(world.resource::<ClipGizmo>().dragging.is_none(), "the release ends the drag");
         // The ring (the normal's tip, on the viewer's left), dragged up by
@@ -305,7 +305,7 @@ mod tests {
         let moved = shown(&mut world, e);
         let up = Vec2::new(0.0, -TRACKBALL_PIXELS * std::f32::consts::FRAC_PI_4);
         drag(&mut world, moved.ring, moved.ring + up);
-        let plane = world.get::<Dataset>(e).unwrap().clip.planes[0].clone();
+        let plane = world.get::<Dataset>(e).unwrap().clip.planes[0];
         let want = Vec3::new(1.0, 0.0, 1.0).normalize();
         assert!(plane.normal.distance(want) < 1e-3, "normal {}", plane.normal);
         assert!(plane.plane().distance(moved.centre).abs() < 1e-3, "the plane left its centre: {plane:?}");
