@@ -102,6 +102,31 @@ impl Default for RenderingSpec {
     }
 }
 
+impl RenderingSpec {
+    /// The switches of a view (what a saved scene keeps of it).
+    pub fn of(view: &crate::dataset::VolumeView) -> Self {
+        Self {
+            jitter: view.jitter,
+            skip_empty: view.skip_empty,
+            early_termination: view.early_termination,
+            lens_antialias: view.lens_antialias,
+            lens_context_steps: view.lens_context_steps,
+        }
+    }
+
+    /// `view` with these switches.
+    pub fn view(&self, view: crate::dataset::VolumeView) -> crate::dataset::VolumeView {
+        crate::dataset::VolumeView {
+            jitter: self.jitter,
+            skip_empty: self.skip_empty,
+            early_termination: self.early_termination,
+            lens_antialias: self.lens_antialias,
+            lens_context_steps: self.lens_context_steps,
+            ..view
+        }
+    }
+}
+
 /// Where a dataset's voxels come from.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -431,6 +456,24 @@ mod tests {
         // Round trip.
         let again = SceneFile::parse(&s.to_ron().unwrap(), "again").unwrap();
         assert_eq!(again, s);
+    }
+
+    #[test]
+    fn a_views_switches_go_into_the_scene_and_back() {
+        // Every switch off the default, through the scene file's text and back.
+        let view = crate::dataset::VolumeView {
+            jitter: false,
+            skip_empty: false,
+            early_termination: false,
+            lens_antialias: false,
+            lens_context_steps: true,
+            ..Default::default()
+        };
+        let scene = SceneFile { rendering: RenderingSpec::of(&view), ..SceneFile::parse("(datasets: [])", "t").unwrap() };
+        let again = SceneFile::parse(&scene.to_ron().unwrap(), "again").unwrap();
+        assert_eq!(again.rendering.view(Default::default()), view);
+        // A scene without them keeps the defaults.
+        assert_eq!(SceneFile::parse("(datasets: [])", "t").unwrap().rendering, RenderingSpec::default());
     }
 
     #[test]

@@ -145,15 +145,7 @@ impl GpuRun {
         let pointer = scene.pointer.map(|(x, y, z)| Vec3::new(x, y, z));
         replace_windows(self.off.world_mut(), &scene.windows, &looks, &self.entities, Some(camera), pointer);
         replace_markers(self.off.world_mut(), &scene.markers, &self.entities);
-        let r = scene.rendering;
-        self.off.set_view(VolumeView {
-            jitter: r.jitter,
-            skip_empty: r.skip_empty,
-            early_termination: r.early_termination,
-            lens_antialias: r.lens_antialias,
-            lens_context_steps: r.lens_context_steps,
-            ..Default::default()
-        });
+        self.off.set_view(scene.rendering.view(VolumeView::default()));
         self.off.set_background(scene.background());
         self.off.set_camera(cam);
         if settle > 0 {

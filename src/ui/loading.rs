@@ -117,7 +117,8 @@ pub fn finish_loads(
     old_lenses: Query<Entity, With<Lens>>,
     old_parts: Query<Entity, With<crate::explode::Part>>,
     mut session: ResMut<Session>,
-    mut light: ResMut<SceneLight>,
+    // (The light and the view's switches a scene brings; the headless app has no view.)
+    (mut light, mut state): (ResMut<SceneLight>, Option<ResMut<super::state::AppState>>),
 ) {
     for (entity, mut load) in &mut loads {
         let Some(result) = check_ready(&mut load.task) else { continue };
@@ -175,6 +176,9 @@ pub fn finish_loads(
                     }
                 }
                 light.0 = scene.light;
+                if let Some(state) = state.as_mut().filter(|_| is_scene) {
+                    state.view = scene.rendering.view(state.view);
+                }
                 session.reframe = Some(Reframe { bounds: visible_bounds(&datasets), camera: is_scene.then(|| scene.camera.clone()) });
                 session.scene = Some(scene);
                 session.base = base;

@@ -297,6 +297,7 @@ pub fn ui(
                         background: state.background,
                         light: light.0,
                         lenses: &lens_params.ordered().into_iter().map(|(_, l, _)| l).collect::<Vec<_>>(),
+                        rendering: crate::scene::file::RenderingSpec::of(&state.view),
                     },
                     &session,
                     windows,
@@ -537,6 +538,7 @@ struct ViewState<'a> {
     background: [f32; 3],
     light: Light,
     lenses: &'a [crate::lens::Lens],
+    rendering: crate::scene::file::RenderingSpec,
 }
 
 /// Writes the app's state as a scene file at `path` (`.ron` added when missing).
@@ -549,7 +551,7 @@ fn save_scene(
     explode: &crate::explode::edit::CurrentSpecs,
 ) -> Result<(), String> {
     use crate::scene::save::{DatasetState, scene_file};
-    let ViewState { camera, background, light, lenses } = view;
+    let ViewState { camera, background, light, lenses, rendering } = view;
     let states: Vec<DatasetState> = rows
         .iter()
         .map(|(e, o, d, t)| DatasetState {
@@ -565,6 +567,7 @@ fn save_scene(
     let camera = camera.ok_or("no camera")?;
     let size = session.scene.as_ref().map(|s| s.size).unwrap_or((512, 512));
     let mut scene = scene_file(&states, &camera, background, light, size, lenses, &session.base);
+    scene.rendering = rendering;
     scene.windows = windows.windows;
     scene.pointer = windows.pointer;
     scene.markers = windows.markers;
