@@ -71,7 +71,7 @@ fn code_class(labels: Region, code: u32) -> u32 {
     return u32(lut_texel(labels.lut_offset + labels.lut_width + code, scene.lut_atlas_width).x + 0.5);
 }
 
-// Whether the cell of label voxel q may hold more than one class: its brick's bit in
+// Whether the cell of label voxel q may hold more than one label: its brick's bit in
 // the label record's occupancy (render::pack, twolevel::boundary_bricks).
 fn boundary_brick(labels: Region, q: vec3<f32>) -> bool {
     if (labels.flags & REGION_OCCUPANCY) == 0u {

@@ -114,7 +114,8 @@ pub struct PreparedObjects<'a> {
     pub on_grid: bool,
     /// `Segmentation::own_values` (for bricked data the GPU checks level 0's grid).
     pub own_values: bool,
-    /// Each label code's class (`twolevel::code_classes`): codes of the same objects.
+    /// Each label code's class (`twolevel::code_classes`): codes of the same objects
+    /// (with `own_values` only).
     pub classes: Vec<u16>,
 }
 
@@ -178,9 +179,11 @@ impl<'a> PreparedRegion<'a> {
                     && seg.labels.dims() == volume.dims()
                     && seg.data_to_label(&volume.grid).abs_diff_eq(Affine3A::IDENTITY, 1e-4),
                 own_values: seg.own_values,
-                classes: {
+                classes: if seg.own_values {
                     let table = seg.table(volume);
                     crate::twolevel::code_classes(&table, table.candidates.len())
+                } else {
+                    Vec::new()
                 },
             });
         }

@@ -219,22 +219,28 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
     out.lut.extend(objects.table.candidates.iter().map(|c| c.map(|k| k as f32)));
     let world_to_labels = objects.data_to_label * p.region.world_to_voxel;
     // Each code's class after its candidates (`twolevel::code_classes`), and where a
-    // cell may straddle classes (`twolevel::class_boundary_bricks`) as the occupancy bits
+    // cell may straddle labels (`twolevel::boundary_bricks`) as the occupancy bits
     // of the label record over its own bricks.
-    out.lut.extend(objects.classes.iter().map(|&c| [c as f32, 0.0, 0.0, 0.0]));
-    let (bricks, boundary) = crate::twolevel::class_boundary_bricks(labels, &objects.table);
-    let occupancy_offset = out.occupancy.len() as u32;
-    let mut words = vec![0u32; boundary.len().div_ceil(32)];
-    for (i, _) in boundary.iter().enumerate().filter(|(_, b)| **b) {
-        words[i / 32] |= 1 << (i % 32);
+    // (With own values only: the shader reads neither otherwise.)
+    let (mut flags, mut bricks, occupancy_offset) = (0, UVec4::ZERO, out.occupancy.len() as u32);
+    if objects.own_values {
+        out.lut.extend(objects.classes.iter().map(|&c| [c as f32, 0.0, 0.0, 0.0]));
+        let grid = labels.bricks();
+        let boundary = crate::twolevel::boundary_bricks(grid);
+        bricks = grid.dims.extend(grid.size);
+        let mut words = vec![0u32; boundary.len().div_ceil(32)];
+        for (i, _) in boundary.iter().enumerate().filter(|(_, b)| **b) {
+            words[i / 32] |= 1 << (i % 32);
+        }
+        out.occupancy.extend(words);
+        flags = region_flags::OCCUPANCY;
     }
-    out.occupancy.extend(words);
     out.regions.push(GpuRegion {
         world_to_voxel: Mat4::from(world_to_labels),
         dims: labels.dims().as_vec3().extend(labels.code_max() as f32),
         atlas_offset: out.levels[label_slot][0].as_vec3().extend(0.0),
         mode: mode::OFF,
-        flags: region_flags::OCCUPANCY,
+        flags,
         bricks,
         occupancy_offset,
         lut_offset,

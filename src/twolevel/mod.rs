@@ -49,51 +49,22 @@
 pub mod spec;
 
 use crate::region::ObjectTable;
-use crate::volume::{BrickGrid, Volume, Voxels};
+use crate::volume::BrickGrid;
 
 /// Each label code's class: codes with the same candidate objects (so the same part for
 /// every value) share the class of the first of them; codes past the table are the rest.
 pub fn code_classes(table: &ObjectTable, codes: usize) -> Vec<u16> {
     let rest = [0u16; crate::region::appearance::MAX_CANDIDATES];
-    let of = |c: usize| table.candidates.get(c).copied().unwrap_or(rest);
-    (0..codes).map(|c| (0..=c).find(|&d| of(d) == of(c)).unwrap_or(c) as u16).collect()
+    let mut first = std::collections::HashMap::new();
+    (0..codes).map(|c| *first.entry(table.candidates.get(c).copied().unwrap_or(rest)).or_insert(c as u16)).collect()
 }
 
-/// The bricks of `labels` (its own brick grid) where a sample's cell may hold voxels of
-/// more than one class ([`code_classes`]): [`boundary_bricks`] over the classes.
-pub fn class_boundary_bricks(labels: &Volume, table: &ObjectTable) -> (glam::UVec4, Vec<bool>) {
-    let classes = code_classes(table, labels.code_max() as usize + 1);
-    let codes = (0..labels.voxels.len()).map(|i| classes.get(labels.voxels.code(i) as usize).copied().unwrap_or(u16::MAX)).collect();
-    let grid = BrickGrid::build(&Voxels::U16(codes), labels.dims(), labels.bricks().size);
-    (grid.dims.extend(grid.size), boundary_bricks(&grid))
-}
-
-/// The label bricks where a sample's cell may hold more than one label: all but those
-/// that hold one code, as do their 26 neighbours, the same one (a cell's eight voxels lie
-/// within its nearest voxel's brick and the bricks around it). `labels`: the label
-/// volume's brick grid (per brick the smallest and largest code).
+/// The label bricks where a sample's cell may hold more than one label: those of more
+/// than one code. A brick's code range covers every voxel a trilinear sample in it
+/// touches (`volume::bricks`: a one-voxel apron), so a brick of one code holds whole
+/// cells of one label, and of one object.
 pub fn boundary_bricks(labels: &BrickGrid) -> Vec<bool> {
-    let d = labels.dims.as_ivec3();
-    let index = |b: glam::IVec3| (b.z * d.y * d.x + b.y * d.x + b.x) as usize;
-    let mut out = Vec::with_capacity(labels.min.len());
-    for z in 0..d.z {
-        for y in 0..d.y {
-            for x in 0..d.x {
-                let b = glam::IVec3::new(x, y, z);
-                let code = labels.min[index(b)];
-                let mut uniform = true;
-                for n in (-1..=1).flat_map(|k| (-1..=1).flat_map(move |j| (-1..=1).map(move |i| glam::IVec3::new(i, j, k)))) {
-                    let c = b + n;
-                    if c.cmpge(glam::IVec3::ZERO).all() && c.cmplt(d).all() {
-                        let i = index(c);
-                        uniform &= labels.min[i] == code && labels.max[i] == code;
-                    }
-                }
-                out.push(!uniform);
-            }
-        }
-    }
-    out
+    labels.min.iter().zip(&labels.max).map(|(lo, hi)| lo != hi).collect()
 }
 
 #[cfg(test)]
@@ -101,17 +72,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn boundary_bricks_are_those_next_to_a_change_of_label() {
-        // Five bricks in a row: codes 0, 0, 0–1, 1, 1 (min–max). Brick 2 holds two labels;
-        // 1 and 3 border it; 0 and 4 see one label all around.
-        let grid = BrickGrid { size: 8, dims: glam::UVec3::new(5, 1, 1), min: vec![0, 0, 0, 1, 1], max: vec![0, 0, 1, 1, 1] };
-        assert_eq!(boundary_bricks(&grid), vec![false, true, true, true, false]);
-        // Two one-label bricks of different codes side by side: both.
-        let grid = BrickGrid { size: 8, dims: glam::UVec3::new(2, 1, 1), min: vec![3, 4], max: vec![3, 4] };
-        assert_eq!(boundary_bricks(&grid), vec![true, true]);
-        // One label everywhere: none.
-        let grid = BrickGrid { size: 8, dims: glam::UVec3::new(2, 2, 2), min: vec![7; 8], max: vec![7; 8] };
-        assert!(boundary_bricks(&grid).iter().all(|b| !b));
+    fn boundary_bricks_are_those_of_more_than_one_code() {
+        use crate::volume::{Grid, Source, ValueMap, Volume, Voxels};
+        let bricks = |change: u32| {
+            let codes = (0..40u32).map(|x| if x < change { 3 } else { 5 }).collect();
+            let grid = Grid::centered(glam::UVec3::new(40, 1, 1), glam::Vec3::ONE);
+            let labels = Volume::new("l", grid, Voxels::U8(codes), ValueMap::IDENTITY, Source::default()).unwrap();
+            boundary_bricks(labels.bricks())
+        };
+        // 40 voxels along x in bricks of 8, codes 3 below the change and 5 from it. At
+        // x = 20 brick 2 holds it; with their aprons bricks 1 (voxels 7–16) and 3
+        // (23–32) hold one code each.
+        assert_eq!(bricks(20), vec![false, false, true, false, false]);
+        // At a brick's edge (x = 16) the aprons take the change into both bricks.
+        assert_eq!(bricks(16), vec![false, true, true, false, false]);
     }
 
     #[test]
