@@ -32,7 +32,7 @@
 
 #import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput
 #import focal::types::{Region, MODE_TWO_LEVEL, MODE_MIP, MODE_MIN_IP, MODE_ISO, REGION_LABELS, REGION_OCCUPANCY, VIEW_JITTER, VIEW_SKIP_EMPTY, VIEW_EARLY_TERMINATION, VIEW_DEBUG_RAYS, VIEW_DEBUG_COUNTS, EARLY_TERMINATION, MAX_RAY_REGIONS, REGION_CLUSTER}
-#import focal::bindings::{settings, scene, regions, depth_texture}
+#import focal::bindings::{view, settings, scene, regions, depth_texture}
 #import focal::camera::{Ray, pixel_ray, scene_depth_t, jitter}
 #import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod}
 #import focal::regions::{region_interval, hole_interval, meets_sphere, pick_region, to_voxel, dir_to_voxel, world_step}
@@ -68,7 +68,10 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
         return vec4(ray.dir * 0.5 + 0.5, 1.0);
     }
     let pixel = vec2<u32>(in.position.xy);
-    let t_scene = scene_depth_t(ray, in.uv, textureLoad(depth_texture, vec2<i32>(in.position.xy), 0));
+    // (The depth texture has the view's own pixels, also when the rays are drawn at a
+    // reduced resolution: the full-resolution pixel under this one's centre.)
+    let full = view.viewport.xy + in.uv * view.viewport.zw;
+    let t_scene = scene_depth_t(ray, in.uv, textureLoad(depth_texture, vec2<i32>(full), 0));
 
     // 1. Intervals of the regions the ray crosses, and what the march needs of their
     // regions (read here, where the region index is the same in every lane: read later

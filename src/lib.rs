@@ -15,6 +15,7 @@ pub mod clip;
 pub mod context;
 pub mod dataset;
 pub mod explode;
+pub mod interactive;
 pub mod lens;
 pub mod reference;
 pub mod region;
@@ -41,6 +42,7 @@ impl PluginGroup for FocalCorePlugins {
             .add(windows::VolumeWindowPlugin)
             .add(explode::ExplodePlugin)
             .add(streaming::StreamingPlugin)
+            .add(interactive::InteractivePlugin)
     }
 }
 

@@ -218,3 +218,56 @@ fn scenes_bring_their_windows() {
     assert!(scene.regions.len() >= 4, "{} regions", scene.regions.len());
     assert_eq!(scene.regions.iter().map(|r| r.holes.len()).collect::<Vec<_>>()[..2], [1, 1], "the box a hole in each dataset");
 }
+
+/// Interactive resolution as the app's camera carries it: a moving camera whose frames
+/// take 200 ms draws fewer pixels (towards the 50 ms target), and once it rests the
+/// picture refines to every pixel.
+#[test]
+fn a_moving_view_draws_fewer_pixels_and_refines_at_rest() {
+    use bevy::time::TimeUpdateStrategy;
+    use focal::dataset::VolumeView;
+    use focal::interactive::InteractiveResolution;
+    let mut app = headless_app();
+    app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(200)));
+    let camera = app
+        .world_mut()
+        .spawn((Camera3d::default(), Transform::from_xyz(0.0, -100.0, 0.0), VolumeView::default(), InteractiveResolution::default()))
+        .id();
+    let resolution = |app: &App| app.world().get::<VolumeView>(camera).map(|v| v.resolution);
+    for _ in 0..3 {
+        app.update();
+    }
+    assert_eq!(resolution(&app), Some(1.0), "at rest from the start");
+    // Orbit: a new camera position every frame.
+    let mut drawn = Vec::new();
+    for k in 0..8 {
+        if let Some(mut t) = app.world_mut().get_mut::<Transform>(camera) {
+            *t = Transform::from_xyz(100.0 * ((k + 1) as f32 * 0.1).sin(), -100.0 * ((k + 1) as f32 * 0.1).cos(), 0.0);
+        }
+        app.update();
+        drawn.push(resolution(&app).unwrap_or(f32::NAN));
+    }
+    // (Frames of 200 ms against 50: a quarter of the pixels per axis would do; each
+    // frame steps by at most (50/200)^¼.)
+    assert!(drawn.iter().all(|s| *s < 1.0), "{drawn:?}");
+    assert!(drawn.windows(2).all(|w| w[1] <= w[0]) && drawn[7] <= 0.3, "{drawn:?}");
+    let moving = app.world().get::<InteractiveResolution>(camera).map(|a| a.moving);
+    assert_eq!(moving, Some(true));
+    // At rest: after 150 ms without change the scale doubles every frame up to 1.
+    let mut rest = Vec::new();
+    for _ in 0..6 {
+        app.update();
+        rest.push(resolution(&app).unwrap_or(f32::NAN));
+    }
+    assert_eq!(rest.last(), Some(&1.0), "{rest:?}");
+    assert!(rest.windows(2).all(|w| w[1] >= w[0]), "{rest:?}");
+    // Switched off, the view draws every pixel while it moves.
+    if let Some(mut a) = app.world_mut().get_mut::<InteractiveResolution>(camera) {
+        a.enabled = false;
+    }
+    if let Some(mut t) = app.world_mut().get_mut::<Transform>(camera) {
+        t.translation.z += 10.0;
+    }
+    app.update();
+    assert_eq!(resolution(&app), Some(1.0));
+}

@@ -18,6 +18,8 @@ mod common;
 mod context;
 #[path = "gpu/explode.rs"]
 mod explode;
+#[path = "gpu/interactive.rs"]
+mod interactive;
 #[path = "gpu/lenses.rs"]
 mod lenses;
 #[path = "gpu/twolevel.rs"]
@@ -367,7 +369,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 31] = [
+    let tests: [GpuTest; 32] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -382,6 +384,10 @@ fn main() {
         ("antialiasing_removes_moire_where_lenses_compress", lenses::antialiasing_removes_moire_where_lenses_compress),
         ("feature_lens_matches_the_reference", lenses::feature_lens_matches_the_reference),
         ("a_lens_that_compresses_nothing_takes_no_more_samples", lenses::a_lens_that_compresses_nothing_takes_no_more_samples),
+        (
+            "a_reduced_resolution_is_the_picture_of_fewer_rays_upscaled",
+            interactive::a_reduced_resolution_is_the_picture_of_fewer_rays_upscaled,
+        ),
         ("context_matches_the_reference", context::context_matches_the_reference),
         ("kappa_t_zero_is_dvr_on_the_gpu", context::kappa_t_zero_is_dvr_on_the_gpu),
         ("clipping_matches_the_reference", clip::clipping_matches_the_reference),

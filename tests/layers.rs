@@ -36,6 +36,8 @@ const LAYERS: &[&str] = &[
     "explode",
     // Streaming bricked datasets: the bricks every view (lenses, windows, parts) wants.
     "streaming",
+    // Interactive resolution: what a moving view draws at.
+    "interactive",
     // The GPU ray caster: packs what the techniques produce.
     "render",
     "lib.rs",

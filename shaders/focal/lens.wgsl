@@ -285,8 +285,11 @@ var<private> backward_deltas: array<vec3<f32>, 4>;
 // Prepares the pixel's footprint (no anti-aliasing where a right or lower neighbour
 // has no ray; forward differences only where a left or upper one has none).
 // One pixel right and one down, in uv.
+// The uv offsets of a ray's right and lower neighbours: the pixels drawn, which are
+// larger than the view's at a reduced resolution (render::reduced).
 fn pixel_steps() -> array<vec2<f32>, 2> {
-    return array<vec2<f32>, 2>(vec2(1.0 / view.viewport.z, 0.0), vec2(0.0, 1.0 / view.viewport.w));
+    let drawn = view.viewport.zw * max(settings.resolution, 1e-3);
+    return array<vec2<f32>, 2>(vec2(1.0 / drawn.x, 0.0), vec2(0.0, 1.0 / drawn.y));
 }
 
 fn lens_footprint(uv: vec2<f32>, ray: Ray) {

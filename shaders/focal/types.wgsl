@@ -72,7 +72,8 @@ struct Settings {
     flags: u32,
     frame: u32,
     lens_count: u32,
-    pad: u32,
+    // Fraction of the view's pixels per axis the ray caster draws (render::reduced).
+    resolution: f32,
     lenses: array<Lens, 4>,
     lens_data: array<vec4<f32>, 64>,
 }

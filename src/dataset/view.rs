@@ -5,6 +5,9 @@ use bevy::prelude::*;
 
 use crate::region::Light;
 
+/// The lowest [`VolumeView::resolution`]: an eighth of the pixels per axis.
+pub const MIN_RESOLUTION: f32 = 0.125;
+
 /// Marks a camera that shows the volumes, with its rendering switches.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 pub struct VolumeView {
@@ -30,8 +33,20 @@ pub struct VolumeView {
     pub gpu_silhouettes: bool,
     /// Seed of the jitter pattern.
     pub frame: u32,
+    /// Fraction of the view's pixels per axis the rays are drawn at, upscaled to the
+    /// view (1: every pixel; at least [`MIN_RESOLUTION`]): what
+    /// [`super::resolution::InteractiveResolution`] lowers while the view moves.
+    pub resolution: f32,
     /// Light of the view (copied from the scene each frame).
     pub light: Light,
+}
+
+impl VolumeView {
+    /// [`Self::resolution`] as the renderer takes it: within [`MIN_RESOLUTION`] … 1, and
+    /// 1 where it is not a number.
+    pub fn drawn_resolution(&self) -> f32 {
+        if self.resolution.is_finite() { self.resolution.clamp(MIN_RESOLUTION, 1.0) } else { 1.0 }
+    }
 }
 
 impl Default for VolumeView {
@@ -46,6 +61,7 @@ impl Default for VolumeView {
             lens_context_steps: false,
             gpu_silhouettes: true,
             frame: 0,
+            resolution: 1.0,
             light: Light::Headlight,
         }
     }

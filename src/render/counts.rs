@@ -58,6 +58,23 @@ pub fn decode_where(image: &image::RgbaImage, keep: impl Fn(u32, u32) -> bool) -
     c
 }
 
+/// A heat map of an image of counts: each pixel's samples over `most` on a ramp from
+/// black (none) through blue, red and yellow to white (`most` or more), so the
+/// pictures of one group, scaled alike, show where their samples go.
+pub fn heat_map(image: &image::RgbaImage, most: u32) -> image::RgbaImage {
+    const RAMP: [[f32; 3]; 5] = [[0.0, 0.0, 0.0], [0.1, 0.2, 0.9], [0.9, 0.1, 0.2], [1.0, 0.85, 0.1], [1.0, 1.0, 1.0]];
+    let mut out = image::RgbaImage::new(image.width(), image.height());
+    for (x, y, p) in image.enumerate_pixels() {
+        let (n, _) = pixel(p.0);
+        let f = (n as f32 / most.max(1) as f32).clamp(0.0, 1.0) * (RAMP.len() - 1) as f32;
+        let i = (f.floor() as usize).min(RAMP.len() - 2);
+        let t = f - i as f32;
+        let c = |a: usize| ((RAMP[i][a] + (RAMP[i + 1][a] - RAMP[i][a]) * t) * 255.0).round() as u8;
+        out.put_pixel(x, y, image::Rgba([c(0), c(1), c(2), 255]));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -74,5 +91,21 @@ mod tests {
         assert!((c.per_ray() - 138.0).abs() < 1e-9);
         assert_eq!(decode(&image::RgbaImage::new(3, 3)), RayCounts::default());
         assert_eq!(decode_where(&img, |x, _| x == 1).samples, 256);
+    }
+
+    #[test]
+    fn heat_maps_ramp_from_black_to_white() {
+        let mut img = image::RgbaImage::new(3, 1);
+        img.put_pixel(1, 0, image::Rgba([100, 0, 0, 255]));
+        img.put_pixel(2, 0, image::Rgba([144, 1, 0, 255]));
+        let h = heat_map(&img, 400);
+        assert_eq!(h.get_pixel(0, 0).0, [0, 0, 0, 255]);
+        // 100 of 400: the ramp's second stop (blue).
+        let blue = h.get_pixel(1, 0).0;
+        for (got, want) in blue.iter().zip([25.5, 51.0, 229.5, 255.0]) {
+            assert!((*got as f32 - want).abs() <= 0.5, "{blue:?}");
+        }
+        // 400 (0x190) or more: white.
+        assert_eq!(h.get_pixel(2, 0).0, [255, 255, 255, 255]);
     }
 }

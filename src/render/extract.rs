@@ -47,7 +47,9 @@ impl ExtractComponent for VolumeView {
             Light::Headlight => Vec4::ZERO,
             Light::Direction(d) => d.normalize_or_zero().extend(1.0),
         };
-        let mut settings = GpuSettings { light, flags, frame: v.frame, ..Default::default() };
+        // (Counts are written per pixel of the view: upscaled they would be blends.)
+        let resolution = if v.debug_counts { 1.0 } else { v.drawn_resolution() };
+        let mut settings = GpuSettings { light, flags, frame: v.frame, resolution, ..Default::default() };
         if let Some(lenses) = lenses {
             super::lens_pack::pack_lenses(&mut settings, &lenses.lenses);
         }

@@ -247,7 +247,9 @@ pub struct GpuSettings {
     pub flags: u32,
     pub frame: u32,
     pub lens_count: u32,
-    pub pad: u32,
+    /// Fraction of the view's pixels per axis the rays are drawn at
+    /// ([`crate::dataset::VolumeView::resolution`], [`super::reduced`]).
+    pub resolution: f32,
     pub lenses: [GpuLens; crate::lens::MAX_LENSES],
     /// Outline vertices (two per vec4) or sampling tables (four values per vec4),
     /// `DATA_PER_LENS` per lens.
@@ -261,7 +263,7 @@ impl Default for GpuSettings {
             flags: 0,
             frame: 0,
             lens_count: 0,
-            pad: 0,
+            resolution: 1.0,
             lenses: [GpuLens::default(); crate::lens::MAX_LENSES],
             lens_data: [Vec4::ZERO; crate::lens::MAX_LENSES * lens_codes::DATA_PER_LENS],
         }

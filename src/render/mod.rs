@@ -11,7 +11,8 @@
 //!   something changed;
 //! - [`pass`] draws one full-screen triangle per view running `shaders/raycast.wgsl`,
 //!   after the opaque and transparent main passes so it reads their depth, blending the
-//!   premultiplied result over the meshes.
+//!   premultiplied result over the meshes; a view drawn at a reduced resolution
+//!   ([`reduced`]) has its rays drawn into a smaller texture, then upscaled over it.
 //!
 //! The renderer packs; it does not decide: what is drawn where is the techniques'
 //! business (datasets, windows, exploded parts), expressed as regions.
@@ -27,6 +28,7 @@ pub mod pack;
 pub mod pass;
 pub mod pipeline;
 pub mod progress;
+pub mod reduced;
 pub mod shaders;
 pub mod upload;
 
@@ -70,8 +72,9 @@ impl Plugin for VolumeRenderPlugin {
             .init_resource::<upload::GpuScene>()
             .init_resource::<bricked::atlas::BrickAtlas>()
             .init_resource::<bevy::render::render_resource::SpecializedRenderPipelines<pipeline::RaycastPipeline>>()
+            .init_resource::<bevy::render::render_resource::SpecializedRenderPipelines<reduced::UpscalePipeline>>()
             .add_systems(bevy::render::ExtractSchedule, extract::extract_scene)
-            .add_systems(RenderStartup, (pipeline::init_pipeline, feature_pass::init_feature_pipelines))
+            .add_systems(RenderStartup, (pipeline::init_pipeline, feature_pass::init_feature_pipelines, reduced::init_upscale_pipeline))
             .add_systems(
                 Render,
                 (
@@ -79,6 +82,7 @@ impl Plugin for VolumeRenderPlugin {
                     bricked::atlas::upload_bricks.in_set(RenderSystems::PrepareResources).after(upload::upload_scene),
                     feature_pass::prepare_feature_buffers.in_set(RenderSystems::PrepareResources).after(upload::upload_scene),
                     pipeline::prepare_pipelines.in_set(RenderSystems::Prepare).after(bricked::atlas::upload_bricks),
+                    reduced::prepare_reduced_targets.in_set(RenderSystems::PrepareResources),
                     record_pipeline_state.in_set(RenderSystems::Cleanup),
                 ),
             )

@@ -11,6 +11,7 @@ use bevy::render::view::{ViewDepthTexture, ViewTarget, ViewUniformOffset, ViewUn
 use super::feature_pass::{FeatureBuffers, FeaturePipelines, encode_feature_passes};
 use super::gpu_types::GpuSettings;
 use super::pipeline::{RaycastPipeline, RaycastPipelineId};
+use super::reduced::{ReducedTarget, UpscalePipeline, UpscalePipelineId};
 use super::upload::GpuScene;
 
 // A Bevy system: its parameters are the resources and queries it uses, and a query's
@@ -25,8 +26,10 @@ pub fn raycast_pass(
         &RaycastPipelineId,
         Option<&ExtractedCamera>,
         Option<&FeatureBuffers>,
+        Option<(&ReducedTarget, &UpscalePipelineId)>,
     )>,
     pipeline: Res<RaycastPipeline>,
+    upscale: Res<UpscalePipeline>,
     feature_pipelines: Res<FeaturePipelines>,
     cache: Res<PipelineCache>,
     view_uniforms: Res<ViewUniforms>,
@@ -36,7 +39,7 @@ pub fn raycast_pass(
     progress: Res<super::progress::RenderProgress>,
     mut ctx: RenderContext,
 ) {
-    let (target, depth, view_offset, settings_index, pipeline_id, camera, fields) = view.into_inner();
+    let (target, depth, view_offset, settings_index, pipeline_id, camera, fields, reduced) = view.into_inner();
     if scene.region_count == 0 || !scene.ready() {
         return;
     }
@@ -76,31 +79,75 @@ pub fn raycast_pass(
             pages.as_entire_binding(),
         )),
     );
+    // A view drawn at a reduced resolution: the rays into its smaller texture (cleared,
+    // the whole of it), then that texture over the view (at full resolution until the
+    // upscale pipeline is ready).
+    let upscaled = reduced.and_then(|(reduced, id)| Some((reduced, cache.get_render_pipeline(id.0)?)));
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
-    let mut pass = ctx.command_encoder().begin_render_pass(&RenderPassDescriptor {
-        label: Some("focal_raycast_pass"),
-        color_attachments: &[Some(RenderPassColorAttachment {
-            view: target.main_texture_view(),
-            depth_slice: None,
-            resolve_target: None,
-            ops: Operations { load: LoadOp::Load, store: StoreOp::Store },
-        })],
-        depth_stencil_attachment: None,
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
-    // A camera limited to part of its target (the app's viewport beside the panels):
-    // the full-screen triangle then spans just that part.
-    if let Some(v) = camera.and_then(|c| c.viewport.as_ref()) {
-        let (p, s) = (v.physical_position.as_vec2(), v.physical_size.as_vec2());
-        pass.set_viewport(p.x, p.y, s.x, s.y, v.depth.start, v.depth.end);
+    {
+        let (view, load) = match upscaled {
+            Some((reduced, _)) => (&reduced.texture.default_view, LoadOp::Clear(Default::default())),
+            None => (target.main_texture_view(), LoadOp::Load),
+        };
+        let mut pass = ctx.command_encoder().begin_render_pass(&RenderPassDescriptor {
+            label: Some("focal_raycast_pass"),
+            color_attachments: &[Some(RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: Operations { load, store: StoreOp::Store },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if let (None, Some([x, y, w, h, near, far])) = (upscaled, camera_viewport(camera)) {
+            pass.set_viewport(x, y, w, h, near, far);
+        }
+        let span = diagnostics.pass_span(&mut pass, "focal_raycast");
+        pass.set_pipeline(render_pipeline);
+        pass.set_bind_group(0, &bind_group, &[view_offset.offset, settings_index.index()]);
+        pass.draw(0..3, 0..1);
+        span.end(&mut pass);
     }
-    let span = diagnostics.pass_span(&mut pass, "focal_raycast");
-    pass.set_pipeline(render_pipeline);
-    pass.set_bind_group(0, &bind_group, &[view_offset.offset, settings_index.index()]);
-    pass.draw(0..3, 0..1);
-    span.end(&mut pass);
+    if let Some((reduced, upscale_pipeline)) = upscaled {
+        let bind_group = ctx.render_device().create_bind_group(
+            "focal_upscale_bind_group",
+            &cache.get_bind_group_layout(&upscale.layout),
+            &BindGroupEntries::sequential((&reduced.texture.default_view, &upscale.sampler)),
+        );
+        let mut pass = ctx.command_encoder().begin_render_pass(&RenderPassDescriptor {
+            label: Some("focal_upscale_pass"),
+            color_attachments: &[Some(RenderPassColorAttachment {
+                view: target.main_texture_view(),
+                depth_slice: None,
+                resolve_target: None,
+                ops: Operations { load: LoadOp::Load, store: StoreOp::Store },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if let Some([x, y, w, h, near, far]) = camera_viewport(camera) {
+            pass.set_viewport(x, y, w, h, near, far);
+        }
+        let span = diagnostics.pass_span(&mut pass, "focal_upscale");
+        pass.set_pipeline(upscale_pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.draw(0..3, 0..1);
+        span.end(&mut pass);
+    }
     progress.count_draw();
+}
+
+/// The viewport of a camera limited to part of its target (the app's viewport beside
+/// the panels), as `set_viewport` takes it: the full-screen triangle then spans just
+/// that part.
+fn camera_viewport(camera: Option<&ExtractedCamera>) -> Option<[f32; 6]> {
+    let v = camera?.viewport.as_ref()?;
+    let (p, s) = (v.physical_position.as_vec2(), v.physical_size.as_vec2());
+    Some([p.x, p.y, s.x, s.y, v.depth.start, v.depth.end])
 }

@@ -12,8 +12,11 @@ pub const RAYCAST: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b
 /// The compute shader of the feature lenses' silhouettes.
 pub const FEATURE: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a12");
 
+/// The pass that draws rays of a reduced resolution over the view (`render::reduced`).
+pub const UPSCALE: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a13");
+
 /// (fixed handle, file name, source) of every shader.
-const SHADERS: [(Handle<Shader>, &str, &str); 18] = [
+const SHADERS: [(Handle<Shader>, &str, &str); 19] = [
     (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a01"), "shaders/focal/types.wgsl", include_str!("../../shaders/focal/types.wgsl")),
     (
         uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a02"),
@@ -64,6 +67,7 @@ const SHADERS: [(Handle<Shader>, &str, &str); 18] = [
     ),
     (RAYCAST, "shaders/raycast.wgsl", include_str!("../../shaders/raycast.wgsl")),
     (FEATURE, "shaders/feature.wgsl", include_str!("../../shaders/feature.wgsl")),
+    (UPSCALE, "shaders/upscale.wgsl", include_str!("../../shaders/upscale.wgsl")),
 ];
 
 /// Environment variable naming a folder (a checkout's root) whose `shaders/` replace the

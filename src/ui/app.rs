@@ -103,6 +103,7 @@ fn setup(commands: &mut Commands, egui: &mut EguiGlobalSettings) {
         projection,
         orbit,
         VolumeView::default(),
+        crate::interactive::InteractiveResolution::default(),
         crate::windows::Viewer,
     ));
     commands.spawn((

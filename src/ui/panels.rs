@@ -14,6 +14,7 @@ use super::viewport::set_viewport;
 use super::{lenses, objects_panel, tf_editor};
 use crate::context::{ContextParams, Power};
 use crate::dataset::{Dataset, GpuVolume, SceneLight, SceneRegions};
+use crate::interactive::InteractiveResolution;
 use crate::region::{Light, Lookup, Mode, View};
 use crate::transfer::presets;
 
@@ -75,7 +76,7 @@ pub fn ui(
     mut session: ResMut<Session>,
     mut datasets: DatasetQuery,
     loading: Query<&Loading>,
-    mut cams: Query<(&mut OrbitCamera, &mut Camera), With<MainCamera>>,
+    mut cams: Query<(&mut OrbitCamera, &mut Camera, Option<&mut InteractiveResolution>), With<MainCamera>>,
     windows: Query<&Window, With<PrimaryWindow>>,
     diagnostics: Res<DiagnosticsStore>,
     mut pointer: ResMut<PointerInViewport>,
@@ -133,7 +134,7 @@ pub fn ui(
         });
     });
 
-    let view_forward = cams.single().map(|(o, _)| o.camera().forward()).unwrap_or(Vec3::NEG_Z);
+    let view_forward = cams.single().map(|(o, ..)| o.camera().forward()).unwrap_or(Vec3::NEG_Z);
     let mut ds: Vec<_> = datasets.iter_mut().collect();
     ds.sort_by_key(|(e, ..)| *e);
     let selected = state.selected.min(ds.len().saturating_sub(1));
@@ -214,13 +215,16 @@ pub fn ui(
             egui::CollapsingHeader::new("Volumetric windows").default_open(false).show(ui, |ui| {
                 let rows: Vec<_> = ds.iter().map(|(e, d, _, _, t)| dataset_row(*e, d, t)).collect();
                 let (lo, hi) = scene_bounds(&regions);
-                if let Ok((orbit, _)) = cams.single() {
+                if let Ok((orbit, ..)) = cams.single() {
                     super::windows_panel::panel(ui, &mut window_params, &rows, selected, orbit, (hi - lo).length());
                 }
             });
             egui::CollapsingHeader::new("Camera").default_open(true).show(ui, |ui| {
-                if let Ok((mut orbit, _)) = cams.single_mut() {
+                if let Ok((mut orbit, _, adapt)) = cams.single_mut() {
                     camera_panel(ui, &mut orbit, scene_bounds(&regions));
+                    if let Some(mut adapt) = adapt {
+                        interaction_panel(ui, &mut adapt);
+                    }
                 }
             });
         });
@@ -228,7 +232,7 @@ pub fn ui(
 
     // The rest of the window is the 3D viewport.
     let free = root.available_rect_before_wrap();
-    if let (Ok((_, mut camera)), Ok(window)) = (cams.single_mut(), windows.single()) {
+    if let (Ok((_, mut camera, _)), Ok(window)) = (cams.single_mut(), windows.single()) {
         set_viewport(&mut camera, window, free, ctx.zoom_factor());
     }
     let over_free = ctx.pointer_hover_pos().is_some_and(|p| free.contains(p));
@@ -239,10 +243,10 @@ pub fn ui(
         let mut rows: Vec<_> = datasets.iter().map(|(e, d, _, _, t)| (e, d, t)).collect();
         rows.sort_by_key(|(e, ..)| *e);
         let chosen = rows.get(state.selected.min(rows.len().saturating_sub(1))).copied();
-        let camera = cams.single().ok().map(|(o, _)| o.camera());
+        let camera = cams.single().ok().map(|(o, ..)| o.camera());
         super::clip_gizmo::overlay(&ctx, free, &clip_gizmo, chosen, camera);
     }
-    if let Ok((orbit, _)) = cams.single() {
+    if let Ok((orbit, ..)) = cams.single() {
         window_menu(&ctx, free, &mut window_params, &datasets, orbit, &regions);
     }
 
@@ -262,8 +266,11 @@ pub fn ui(
     if state.show_fps {
         let fps = diagnostics.get(&FrameTimeDiagnosticsPlugin::FPS).and_then(|d| d.smoothed()).unwrap_or(0.0);
         let ms = diagnostics.get(&FrameTimeDiagnosticsPlugin::FRAME_TIME).and_then(|d| d.smoothed()).unwrap_or(0.0);
-        egui::Area::new("fps".into()).fixed_pos(free.right_top() + egui::vec2(-150.0, 8.0)).show(&ctx, |ui| {
-            ui.label(RichText::new(format!("{fps:.1} fps  {ms:.1} ms")).color(Color32::LIGHT_GREEN).monospace());
+        // (The share of the pixels the rays are drawn at while the view moves.)
+        let drawn = cams.single().ok().and_then(|(.., a)| a.filter(|a| a.enabled && a.scale < 1.0).map(|a| a.scale));
+        let drawn = drawn.map_or(String::new(), |s| format!("  rays at {:.0} %", s * 100.0));
+        egui::Area::new("fps".into()).fixed_pos(free.right_top() + egui::vec2(-260.0, 8.0)).show(&ctx, |ui| {
+            ui.label(RichText::new(format!("{fps:.1} fps  {ms:.1} ms{drawn}")).color(Color32::LIGHT_GREEN).monospace());
         });
     }
     if let Some(e) = session.error.clone() {
@@ -293,7 +300,7 @@ pub fn ui(
                     &path,
                     &ds_states(&datasets),
                     ViewState {
-                        camera: cams.single().map(|(o, _)| o.camera()).ok(),
+                        camera: cams.single().map(|(o, ..)| o.camera()).ok(),
                         background: state.background,
                         light: light.0,
                         lenses: &lens_params.ordered().into_iter().map(|(_, l, _)| l).collect::<Vec<_>>(),
@@ -478,6 +485,19 @@ fn rendering_panel(ui: &mut Ui, d: &mut Dataset, state: &mut AppState, light: &m
     ui.checkbox(&mut state.view.lens_context_steps, "fast lenses on streamed data").on_hover_text(
         "Under a lens, streamed data steps along the ray at the context's rate: native voxels across, \
          about the cost of no lens, but structures thin along the ray may be missed",
+    );
+}
+
+/// The view's interactive resolution: on or off, the frame time it holds while moving.
+fn interaction_panel(ui: &mut Ui, adapt: &mut InteractiveResolution) {
+    ui.separator();
+    ui.checkbox(&mut adapt.enabled, "fewer pixels while moving").on_hover_text(
+        "While the camera, a lens, a window or a slider moves, the rays are drawn at a lower \
+         resolution that holds the frame time below, then refined to every pixel when it rests",
+    );
+    ui.add_enabled(
+        adapt.enabled,
+        egui::Slider::new(&mut adapt.target_ms, 16.0..=500.0).logarithmic(true).suffix(" ms").text("frame time while moving"),
     );
 }
 

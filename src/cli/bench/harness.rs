@@ -63,6 +63,8 @@ pub(super) struct Bench {
     /// The GPU's per-ray counts of each configuration of the last [`Self::rounds`]
     /// (`focal::render::counts`), from one frame of each before the timing.
     pub(super) counts: Vec<RayCounts>,
+    /// The images of those counts (`--save` writes their heat maps).
+    pub(super) count_images: Vec<image::RgbaImage>,
     /// Each configuration's ratio against the first of the last [`Self::rounds`].
     pub(super) paired: Vec<Paired>,
 }
@@ -155,11 +157,13 @@ impl Bench {
         // samples.
         let mut images = Vec::new();
         self.counts.clear();
+        self.count_images.clear();
         for i in 0..count {
             set(&mut self.off, i);
             images.push(self.off.capture()?);
             let counts = self.off.capture_counts()?;
             self.counts.push(decode(&counts));
+            self.count_images.push(counts);
         }
         let mut times = vec![Vec::new(); count];
         // One round untimed (caches, clocks), then the timed ones.
@@ -227,13 +231,23 @@ pub(super) fn names(configs: &[Config]) -> Vec<&'static str> {
 }
 
 impl Bench {
-    /// Writes a group's pictures when `--save` asked for them.
+    /// Writes a group's pictures when `--save` asked for them, and the heat maps of the
+    /// samples of the last [`Self::rounds`]' configurations (`GROUP-samples-N.png`, all
+    /// on the scale of the group's most samples in a ray, printed).
     pub(super) fn save_images(&self, group: &str, images: &[image::RgbaImage]) -> Result<(), String> {
         let Some(dir) = &self.save else { return Ok(()) };
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         for (i, im) in images.iter().enumerate() {
             let path = dir.join(format!("{group}-{i}.png"));
             im.save(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        let most = self.counts.iter().map(|c| c.most).max().unwrap_or(0);
+        for (i, counts) in self.count_images.iter().enumerate() {
+            let path = dir.join(format!("{group}-samples-{i}.png"));
+            focal::render::counts::heat_map(counts, most).save(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        if !self.count_images.is_empty() {
+            eprintln!("{group}: sample heat maps scaled to {most} samples a ray (white)");
         }
         Ok(())
     }

@@ -17,7 +17,9 @@
 //! `--explode` (exploded views, [`explode`]: the paper's table 1, 1 to 64 parts at rest
 //! and exploded against the plain ray caster; goal ≥ 80 % at 64 parts), `--bricked`
 //! (streaming brick by brick, [`bricked`]: orbiting a source 8× the cache against the
-//! chosen level in memory, a magnifier over it, the first frame of 8192³, peak memory). Each line
+//! chosen level in memory, a magnifier over it, the first frame of 8192³, peak memory),
+//! `--interactive` (the orbiting camera's frame with its rays at ½ and ¼ of the pixels
+//! per axis and at the app's adaptive resolution, [`interactive`]). Each line
 //! ends with the ratio against its group's baseline; `--json` prints the same as JSON,
 //! `--save DIR` writes each configuration's picture, and `FOCAL_BENCH_SAMPLES=1` prints
 //! every timed frame. Configurations are timed in interleaved rounds (one frame of each
@@ -46,6 +48,7 @@ use serde_json::json;
 mod bricked;
 mod explode;
 mod harness;
+mod interactive;
 mod windows;
 
 use harness::{Bench, difference, names, push_group};
@@ -88,6 +91,9 @@ pub struct BenchArgs {
     /// Only the bricked-streaming group (issue 23).
     #[arg(long)]
     bricked: bool,
+    /// Only the interactive-resolution group (the moving camera at fewer pixels).
+    #[arg(long)]
+    interactive: bool,
     /// With --explode: only these part counts (1, 2, 4, 8, 16, 32, 64; comma-separated).
     #[arg(long, value_delimiter = ',', value_name = "N,...")]
     parts: Vec<usize>,
@@ -95,7 +101,8 @@ pub struct BenchArgs {
     #[arg(long)]
     json: bool,
     /// Save the picture of every configuration timed in rounds into this folder
-    /// (`GROUP-N.png`, N in the order of the group's lines).
+    /// (`GROUP-N.png`, N in the order of the group's lines) and heat maps of their
+    /// samples per ray (`GROUP-samples-N.png`).
     #[arg(long, value_name = "DIR")]
     save: Option<std::path::PathBuf>,
 }
@@ -114,13 +121,21 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         || args.twolevel
         || args.windows
         || args.explode
-        || args.bricked);
+        || args.bricked
+        || args.interactive);
     let off = Offscreen::new(w, h, |app| {
         app.add_plugins(FocalPlugins);
     })?;
     eprintln!("GPU: {}  image {w}×{h}, {} rounds", off.adapter_name(), args.frames);
-    let mut bench =
-        Bench { off, frames: args.frames.max(1), save: args.save.clone(), camera: None, counts: Vec::new(), paired: Vec::new() };
+    let mut bench = Bench {
+        off,
+        frames: args.frames.max(1),
+        save: args.save.clone(),
+        camera: None,
+        counts: Vec::new(),
+        count_images: Vec::new(),
+        paired: Vec::new(),
+    };
     let still = VolumeView { jitter: false, ..Default::default() };
     let mut rows = Vec::new();
 
@@ -235,6 +250,10 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
 
     if all || args.bricked {
         bricked::group(&mut bench, &mut rows)?;
+    }
+
+    if all || args.interactive {
+        interactive::group(&mut bench, &mut rows, args.resolution)?;
     }
 
     if all || args.lenses {
