@@ -3,9 +3,10 @@
 // Sampling bricked volumes through their page tables (render::bricked: the CPU
 // reference of the look-up is page_table::PageTree::locate). A region's coarse index
 // q_C becomes the level-0 index q = (q_C + ½)·2^C − ½; its level-0 brick b₀ names the
-// directory word (b₀ >> G) and, where that is a block, the block's word for b₀: the
-// finest drawn brick holding q (resolved on the CPU), the level m over whose brick the
-// answer holds, and the brick's atlas slot. Two reads and no loop or cache: llvmpipe
+// directory word (b₀ >> G) and, where that is a block, the block's word for the ray's
+// level l (capped at G) at b₀ >> l: the finest drawn brick of level l or coarser
+// holding q (resolved on the CPU), the level m over whose brick the answer holds, and
+// the brick's atlas slot. Two reads and no loop or cache: llvmpipe
 // runs every branch in every lane and one pass of every loop, so anything conditional
 // costs every sample.
 
@@ -44,11 +45,16 @@ const GRADIENT_NORMS: u32 = 16u;
 // of level L (set per ray).
 var<private> bricked_step: f32 = 1.0;
 var<private> bricked_gradient_norm: f32 = 1.0;
+// The finest level the ray reads (its footprint's: no data finer than it needs).
+var<private> bricked_cap: u32 = 0u;
 
-// Sets the ray's level l (of 0 … C) in bricked region r; returns its step factor.
-fn set_bricked_level(r: Region, l: f32) -> f32 {
+// Sets the ray's level l (of 0 … C) in bricked region r, and the finest level it reads
+// (`cap`: l, or under a lens with context steps the lens's footprint's level where it is
+// finer); returns its step factor.
+fn set_bricked_level(r: Region, l: f32, cap: f32) -> f32 {
     let f = exp2(l - f32(r.bricked.w));
     bricked_step = f;
+    bricked_cap = u32(max(cap, 0.0));
     let tree = pages[PAGE_HEADER + r.bricked.x - 1u];
     bricked_gradient_norm = bitcast<f32>(pages[tree - GRADIENT_NORMS + u32(l)]);
     return f;
@@ -101,9 +107,13 @@ fn bricked_locate(r: Region, q0: vec3<f32>) {
     let bg = b0 >> vec3(g);
     let ng = brick_count(level_dims(d0, g), size);
     var word = pages[tree + (bg.z * ng.y + bg.y) * ng.x + bg.x];
-    let w = 1u << g;
-    let l = b0 - bg * w;
-    let in_block = pages[tree + (word & 0x3fffffffu) + (l.z * w + l.y) * w + l.x];
+    // (The block's words of level c: (2^(G−c))³ of them after 8^G + … + 8^(G−c+1),
+    // page_table::block_offset.)
+    let c = min(bricked_cap, g);
+    let w = 1u << (g - c);
+    let l = (b0 >> vec3(c)) - bg * w;
+    let offset = ((1u << (3u * (g + 1u))) - (1u << (3u * (g - c + 1u)))) / 7u;
+    let in_block = pages[tree + (word & 0x3fffffffu) + offset + (l.z * w + l.y) * w + l.x];
     word = select(word, in_block, (word >> 30u) == BRICKED_BLOCK);
     let kind = word >> 30u;
     let k = (word >> 26u) & 15u;

@@ -10,6 +10,13 @@
 //! (`2d·tan(θ/2)/H`, orthographic `h/H`), divided by the magnification of any magnifier
 //! whose focus or border the projected box meets, and converted from world to dataset
 //! millimetres by the map's largest scale. A box no region and no view sees is left out.
+//!
+//! Where a view has magnifiers, the context beside them still wants its own level: its
+//! rays read nothing finer than their footprint asks for (`render::bricked::page_table`),
+//! so the bricks of the views without their magnifiers are wanted too (the coarser cut;
+//! where the two cuts differ, under and around the lenses, both are drawn).
+
+use std::collections::HashSet;
 
 use glam::{Affine3A, Vec2, Vec3};
 
@@ -120,6 +127,31 @@ pub fn wanted(
     if regions.is_empty() || views.is_empty() || coarse == 0 {
         return Vec::new();
     }
+    let lensed = cut(levels, coarse, layout, regions, views, max_bricks);
+    if views.iter().all(|v| v.magnifiers.is_empty()) {
+        return lensed;
+    }
+    // Both cuts, coarsest first (the context's bricks are few, and most of the picture),
+    // within the budget.
+    let context: Vec<ViewFrame> = views.iter().map(|v| ViewFrame { magnifiers: Vec::new(), ..v.clone() }).collect();
+    let mut chosen = cut(levels, coarse, layout, regions, &context, max_bricks);
+    let known: HashSet<BrickKey> = chosen.iter().copied().collect();
+    chosen.extend(lensed.into_iter().filter(|k| !known.contains(k)));
+    chosen.sort_by_key(|k| std::cmp::Reverse(k.level));
+    chosen.truncate(max_bricks);
+    chosen
+}
+
+/// The cut of the pyramid `views` want through `regions` (the selection of [`wanted`]
+/// for one set of views).
+fn cut(
+    levels: &[SourceLevel],
+    coarse: usize,
+    layout: BrickLayout,
+    regions: &[Seen],
+    views: &[ViewFrame],
+    max_bricks: usize,
+) -> Vec<BrickKey> {
     let levels = &levels[..=coarse.min(levels.len() - 1)];
     let each = |lo: Vec3, hi: Vec3, f: &mut dyn FnMut(&[Vec3; 8], &Seen, &ViewFrame)| {
         let local = corners(lo, hi);
@@ -195,6 +227,8 @@ mod tests {
         // brick brings all its children), through the whole depth.
         assert!(fine.iter().all(|k| (k.coords().x as i32 - 8).abs() <= 6 && (k.coords().z as i32 - 8).abs() <= 6), "{fine:?}");
         assert!(fine.iter().any(|k| k.coords().y == 0) && fine.iter().any(|k| k.coords().y == 15));
+        // The context's own bricks (level 3 throughout) are wanted beside the lens's.
+        assert!(far.iter().all(|k| magnified.contains(k)), "the context's cut is not wanted under a lens");
         let histogram: Vec<usize> = (0..4).map(|l| magnified.iter().filter(|k| k.level == l).count()).collect();
         // (Level 3's eight bricks all touch the view axis, so all are refined; level 2's
         // away from it stay, and level 0 covers under a fifth of the volume.)

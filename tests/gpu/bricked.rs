@@ -124,6 +124,22 @@ pub fn bricked_ch2_converges_to_the_chosen_level_in_memory(gpu: &mut Gpu) {
     let magnified = show_bricked(gpu, &source, &appearance, &camera, true);
     let status = gpu.off.world_mut().resource::<StreamStatus>().counts();
     assert_eq!(status.finest_wanted, Some(0), "{status:?}");
+    // Around the lens the context is the view without it: its rays read level 1, not
+    // the native bricks drawn for the lens that they cross (the lens reaches 0.7 lens
+    // units, 22.4 pixels; the level-0 bricks it wants reach further).
+    let outside = |a: &image::RgbaImage, b: &image::RgbaImage| {
+        let mut d: Vec<u8> = a
+            .enumerate_pixels()
+            .filter(|(x, y, _)| Vec2::new(*x as f32 - 31.5, *y as f32 - 31.5).length() > 24.0)
+            .flat_map(|(x, y, p)| (0..3).map(move |c| (x, y, p[c], c)))
+            .map(|(x, y, v, c)| v.abs_diff(b.get_pixel(x, y)[c]))
+            .collect();
+        d.sort_unstable();
+        (d.iter().map(|&v| v as f32).sum::<f32>() / d.len().max(1) as f32, d[d.len() * 99 / 100], d[d.len() - 1])
+    };
+    let (mean, p99, max) = outside(&magnified, &bricked);
+    println!("    around the lens against the view without it: mean {mean:.3}, p99 {p99}, max {max} levels");
+    assert!(mean < 0.05 && p99 == 0, "the context around the lens changed (mean {mean:.3}, p99 {p99}, max {max})");
     // Rays under the focus step at level 0, twice as often as level 1's there without
     // the lens (they see other voxels, so only about); every sample looks its brick up
     // in the page table.

@@ -8,12 +8,19 @@
 //! brick `b₀` holding a sample names its ancestors: `b₀ >> k` at level `k`.
 //!
 //! The table has one word per brick of the directory level `G = min(T, 3)` (`T = C − 1`
-//! the finest streamed level's top), and a block of `(2^G)³` words, one per level-0
-//! brick, under every directory brick with a drawn descendant finer than `G`. Each word
-//! is the answer for every sample in its brick: the finest drawn brick holding it (its
-//! kind, level `k` and atlas slot), else the coarse volume; with it the level `m ≥` the
-//! word's own over whose brick the answer holds (the box the ray caster may cross at
-//! once when the answer is empty). A look-up is two reads and no loop
+//! the finest streamed level's top), and a block under every directory brick with a
+//! drawn descendant finer than `G`: for each level `l = 0 … G` one word per level-`l`
+//! brick under it, `(2^(G−l))³` words, level 0 first (`8^G + … + 8 + 1` words,
+//! [`block_offset`]). A level-`l` word is the answer for every sample in its brick of a
+//! ray that steps at level `l` or coarser: the finest drawn brick **of level `l` or
+//! coarser** holding it (its kind, level `k` and atlas slot), else the coarse volume;
+//! with it the level `m ≥ l` over whose brick the answer holds (the box the ray caster
+//! may cross at once when the answer is empty). A ray reads the words of its own level
+//! (capped at `G`; a directory word without a block holds nothing finer than `G`), so
+//! it never samples data finer than its step: the context beside a magnifier reads the
+//! context's level, not the native bricks drawn for the lens, which it would alias and
+//! pay for (four times the samples outside the bench's 4× lens: their small sub-blocks
+//! hold the finest lattice's crests). A look-up is two reads and no loop
 //! (`shaders/focal/bricked.wgsl`, checked against [`PageTree::locate`], itself checked
 //! against sampling whole levels): on llvmpipe every lane runs every branch and one pass
 //! of every loop, so the tree this replaced cost three times the volume's own fetches
@@ -66,6 +73,18 @@ const OFFSET_MASK: u32 = (1 << KIND_SHIFT) - 1;
 /// The directory level of a table over streamed levels `0 … top`.
 pub fn directory_level(top: usize) -> usize {
     top.min(BLOCK_LEVELS)
+}
+
+/// Words of a block before its level-`l` words, under a directory at level `g`:
+/// `8^g + 8^(g−1) + … + 8^(g−l+1) = (8^(g+1) − 8^(g−l+1)) / 7` (the shader computes the
+/// same closed form).
+pub fn block_offset(g: usize, l: usize) -> usize {
+    ((1usize << (3 * (g + 1))) - (1usize << (3 * (g - l.min(g) + 1)))) / 7
+}
+
+/// Words of a block under a directory at level `g`: every level's, `0 … g`.
+pub fn block_len(g: usize) -> usize {
+    block_offset(g, g) + 1
 }
 
 /// The word of `answer` (a drawn brick's page and level; `None`: the coarse volume),
@@ -140,9 +159,8 @@ impl Builder<'_> {
             if level > 0 && self.inner.contains(&key) {
                 let block = self.words.len();
                 self.words[at] = KIND_BLOCK << KIND_SHIFT | block as u32;
-                let w = 1usize << level;
-                self.words.resize(block + w * w * w, 0);
-                self.block(block, key.coords() << level as u32, key, answer);
+                self.words.resize(block + block_len(self.g), 0);
+                self.block(block, key.coords() << level as u32, key, inherited);
             } else {
                 self.words[at] = entry(answer, level, self.grid);
             }
@@ -165,25 +183,30 @@ impl Builder<'_> {
         }
     }
 
-    /// Fills the block at word `block` (level-0 bricks from `origin`) under `key`.
+    /// Fills the block at word `block` (level-0 bricks from `origin`) under `key`: its
+    /// own level's word, and below it its children's or, where nothing finer is drawn,
+    /// its answer for every finer level.
     fn block(&mut self, block: usize, origin: UVec3, key: BrickKey, inherited: Option<(Page, usize)>) {
         let level = key.level as usize;
         let answer = self.answer(key, inherited);
-        if level > 0 && self.inner.contains(&key) {
+        let word = entry(answer, level, self.grid);
+        let leaf = level == 0 || !self.inner.contains(&key);
+        for l in if leaf { 0..=level } else { level..=level } {
+            let w = 1u32 << (self.g - l);
+            let lo = (key.coords() << (level - l) as u32) - (origin >> l as u32);
+            let hi = (lo + (1u32 << (level - l))).min(UVec3::splat(w));
+            let at = block + block_offset(self.g, l);
+            for z in lo.z..hi.z {
+                for y in lo.y..hi.y {
+                    for x in lo.x..hi.x {
+                        self.words[at + ((z * w + y) * w + x) as usize] = word;
+                    }
+                }
+            }
+        }
+        if !leaf {
             for c in self.children(key).collect::<Vec<_>>() {
                 self.block(block, origin, c, answer);
-            }
-            return;
-        }
-        let w = 1u32 << self.g;
-        let word = entry(answer, level, self.grid);
-        let lo = (key.coords() << level as u32) - origin;
-        let hi = (lo + (1u32 << level)).min(UVec3::splat(w));
-        for z in lo.z..hi.z {
-            for y in lo.y..hi.y {
-                for x in lo.x..hi.x {
-                    self.words[block + ((z * w + y) * w + x) as usize] = word;
-                }
             }
         }
     }
@@ -220,9 +243,11 @@ impl PageTree {
         PageTree { layout, dims: dims.to_vec(), words: b.words }
     }
 
-    /// Where continuous level-0 index `q` reads (slots of `edge` texels), and the
-    /// level-0 box `[lo, hi)` over which the answer holds.
-    pub fn locate(&self, q: Vec3) -> (Located, Vec3, Vec3) {
+    /// Where continuous level-0 index `q` reads for a ray stepping at level `cap` (the
+    /// finest drawn brick of level `cap` or coarser; `cap` above the directory level
+    /// reads as at the directory level), and the level-0 box `[lo, hi)` over which the
+    /// answer holds.
+    pub fn locate(&self, q: Vec3, cap: usize) -> (Located, Vec3, Vec3) {
         let Some(top) = self.dims.len().checked_sub(1) else { return (Located::Coarse, Vec3::MIN, Vec3::MAX) };
         let size = self.layout.size;
         let g = directory_level(top) as u32;
@@ -234,9 +259,11 @@ impl PageTree {
         let bg = b0 >> g;
         let mut word = self.words[((bg.z * ng.y + bg.y) * ng.x + bg.x) as usize];
         if word >> KIND_SHIFT == KIND_BLOCK {
-            let w = 1u32 << g;
-            let l = b0 - (bg << g);
-            word = self.words[(word & OFFSET_MASK) as usize + ((l.z * w + l.y) * w + l.x) as usize];
+            let l = cap.min(g as usize) as u32;
+            let w = 1u32 << (g - l);
+            let local = (b0 >> l) - (bg << (g - l));
+            let at = (word & OFFSET_MASK) as usize + block_offset(g as usize, l as usize);
+            word = self.words[at + ((local.z * w + local.y) * w + local.x) as usize];
         }
         let k = (word >> LEVEL_SHIFT & 15) as usize;
         let m = word >> HOLDS_SHIFT & 15;
@@ -276,9 +303,10 @@ mod tests {
     use crate::volume::source::{SourceLevel, VoxelSource, level_count, level_grid};
     use crate::volume::{Grid, Source, ValueMap, Volume, Voxels};
 
-    /// The finest drawn brick holding level-0 voxel index `q`, by brute force.
-    fn finest_drawn(drawn: &HashMap<BrickKey, (Page, u64)>, dims: &[UVec3], size: u32, q: Vec3) -> Option<(usize, Page)> {
-        (0..dims.len()).find_map(|k| {
+    /// The finest drawn brick of level `from` or coarser holding level-0 voxel index
+    /// `q`, by brute force.
+    fn finest_drawn(drawn: &HashMap<BrickKey, (Page, u64)>, dims: &[UVec3], size: u32, q: Vec3, from: usize) -> Option<(usize, Page)> {
+        (from..dims.len()).find_map(|k| {
             let qk = ((q + 0.5) / (1u32 << k) as f32 - 0.5).clamp(Vec3::ZERO, dims[k].as_vec3() - 1.0);
             let b = ((qk + 0.5) / size as f32).floor().as_uvec3().min((dims[k] + size - 1) / size - 1);
             drawn.get(&BrickKey::new(k, b)).map(|(p, _)| (k, *p))
@@ -321,16 +349,25 @@ mod tests {
             _ => false,
         };
         let d = dims[0].as_vec3();
+        // Every cap: a ray stepping at level l reads the finest drawn brick of level l or
+        // coarser (above the directory level 3, of level 3 or coarser).
         for _ in 0..3000 {
             let q = Vec3::new(next() as f32, next() as f32, next() as f32) / u32::MAX as f32 * 2.2 * d - 0.1 * d - 0.5;
-            let (found, lo, hi) = tree.locate(q);
-            assert!(same(found, finest_drawn(&drawn, &dims, 8, q)), "{q}: {found:?} against {:?}", finest_drawn(&drawn, &dims, 8, q));
-            assert!(q.cmpge(lo).all() && q.cmplt(hi).all(), "{q} outside its box {lo} … {hi}");
-            for t in [0.0f32, 0.3, 0.7, 0.999] {
-                let p = lo.max(Vec3::splat(-3.0)) + (hi.min(d + 3.0) - lo.max(Vec3::splat(-3.0))) * t;
-                assert!(same(found, finest_drawn(&drawn, &dims, 8, p)), "{p} in the box of {q}");
+            for cap in 0..=4 {
+                let from = cap.min(3);
+                let (found, lo, hi) = tree.locate(q, cap);
+                let want = finest_drawn(&drawn, &dims, 8, q, from);
+                assert!(same(found, want), "{q} at level {cap}: {found:?} against {want:?}");
+                assert!(q.cmpge(lo).all() && q.cmplt(hi).all(), "{q} outside its box {lo} … {hi}");
+                for t in [0.0f32, 0.3, 0.7, 0.999] {
+                    let p = lo.max(Vec3::splat(-3.0)) + (hi.min(d + 3.0) - lo.max(Vec3::splat(-3.0))) * t;
+                    assert!(same(found, finest_drawn(&drawn, &dims, 8, p, from)), "{p} in the box of {q} at level {cap}");
+                }
             }
         }
+        // The blocks' sizes: 8³ + 4³ + 2³ + 1 words under a directory at level 3.
+        assert_eq!((block_len(3), block_offset(3, 1), block_offset(3, 2), block_offset(3, 3)), (585, 512, 576, 584));
+        assert_eq!((block_len(1), block_offset(1, 0), block_len(0)), (9, 0, 1));
     }
 
     /// Trilinear sampling of `n³` texel slots stored side by side along x.
@@ -371,9 +408,9 @@ mod tests {
         let table_dims = [levels[0].grid.dims, levels[1].grid.dims];
         let grid = UVec3::new(2, 1, 1);
         let tree = PageTree::build(&table_dims, layout, &drawn, grid);
-        // The directory over level 1 (2³ bricks) and one block of 2³ level-0 bricks, under
-        // level-1 brick (0, 0, 0).
-        assert_eq!(tree.words.len(), 8 + 8);
+        // The directory over level 1 (2³ bricks) and one block under level-1 brick
+        // (0, 0, 0): 2³ level-0 bricks and the level-1 brick itself.
+        assert_eq!(tree.words.len(), 8 + 8 + 1);
         let n = layout.stored();
         let blocks: Vec<Vec<f32>> = resident
             .iter()
@@ -420,7 +457,7 @@ mod tests {
             (Vec3::new(7.6, 8.1, 15.9), None),
         ];
         for (q, level) in cases {
-            let (found, lo, hi) = tree.locate(q);
+            let (found, lo, hi) = tree.locate(q, 0);
             assert!(q.cmpge(lo).all() && q.cmplt(hi).all(), "{q} outside its box {lo} … {hi}");
             match (found, level) {
                 (Located::Texel { level: k, texel }, Some(want)) => {
@@ -440,18 +477,26 @@ mod tests {
                     (Located::Texel { level: x, .. }, Located::Texel { level: y, .. }) => x == y,
                     (a, b) => a == b,
                 };
-                assert!(same(tree.locate(p).0, found), "{p} in the box of {q}");
+                assert!(same(tree.locate(p, 0).0, found), "{p} in the box of {q}");
             }
         }
         // The box of a level-0 brick inside the volume, and open past its edges.
-        assert_eq!(tree.locate(Vec3::splat(10.0)).1, Vec3::splat(7.5));
-        assert_eq!(tree.locate(Vec3::splat(10.0)).2, Vec3::splat(15.5));
-        assert_eq!(tree.locate(Vec3::splat(17.0)).2, Vec3::splat(f32::MAX));
+        assert_eq!(tree.locate(Vec3::splat(10.0), 0).1, Vec3::splat(7.5));
+        assert_eq!(tree.locate(Vec3::splat(10.0), 0).2, Vec3::splat(15.5));
+        assert_eq!(tree.locate(Vec3::splat(17.0), 0).2, Vec3::splat(f32::MAX));
+        // A ray stepping at level 1 reads past the level-0 brick: level 1's (1, 1, 1)
+        // where it is drawn, the coarse level under level-1 brick (0, 0, 0), which is
+        // not (its level-0 child is, for finer rays).
+        assert!(matches!(tree.locate(Vec3::new(17.0, 18.2, 19.0), 1).0, Located::Texel { level: 1, .. }));
+        assert_eq!(tree.locate(Vec3::new(10.3, 11.7, 8.2), 1).0, Located::Coarse);
+        // (That answer holds over level-1 brick (0, 0, 0): open below, 15.5 above.)
+        let (_, lo, hi) = tree.locate(Vec3::new(10.3, 11.7, 8.2), 1);
+        assert_eq!((lo, hi), (Vec3::splat(f32::MIN), Vec3::splat(15.5)));
         // An empty brick is reported with its level; nothing drawn is the coarse level.
         let empty = PageTree::build(&table_dims, layout, &HashMap::from([(BrickKey::new(1, UVec3::ZERO), (Page::Empty(3), 0))]), grid);
-        assert_eq!(empty.locate(Vec3::splat(3.0)).0, Located::Empty { level: 1 });
+        assert_eq!(empty.locate(Vec3::splat(3.0), 0).0, Located::Empty { level: 1 });
         let none = PageTree::build(&table_dims, layout, &HashMap::new(), grid);
         assert_eq!(none.words.len(), 8);
-        assert_eq!(none.locate(Vec3::splat(3.0)).0, Located::Coarse);
+        assert_eq!(none.locate(Vec3::splat(3.0), 0).0, Located::Coarse);
     }
 }
