@@ -226,6 +226,7 @@ fn scenes_bring_their_windows() {
 fn a_moving_view_draws_fewer_pixels_and_refines_at_rest() {
     use bevy::time::TimeUpdateStrategy;
     use focal::dataset::VolumeView;
+    use focal::dataset::view::Accumulate;
     use focal::interactive::InteractiveResolution;
     let mut app = headless_app();
     app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(200)));
@@ -261,6 +262,22 @@ fn a_moving_view_draws_fewer_pixels_and_refines_at_rest() {
     }
     assert_eq!(rest.last(), Some(&1.0), "{rest:?}");
     assert!(rest.windows(2).all(|w| w[1] >= w[0]), "{rest:?}");
+    // At every pixel and at rest, frames of different jitter are averaged: the index
+    // of the average and the jitter's seed count the frames.
+    let accumulated = |app: &App| app.world().get::<Accumulate>(camera).map(|a| a.index);
+    let seed = |app: &App| app.world().get::<VolumeView>(camera).map(|v| v.frame);
+    let before = accumulated(&app).unwrap_or(0);
+    app.update();
+    app.update();
+    assert_eq!(accumulated(&app), Some(before + 2));
+    assert_eq!(seed(&app), Some(before + 2));
+    // Moving again: no average, the seed back to 0.
+    if let Some(mut t) = app.world_mut().get_mut::<Transform>(camera) {
+        t.translation.x += 5.0;
+    }
+    app.update();
+    assert_eq!(accumulated(&app), None);
+    assert_eq!(seed(&app), Some(0));
     // Switched off, the view draws every pixel while it moves.
     if let Some(mut a) = app.world_mut().get_mut::<InteractiveResolution>(camera) {
         a.enabled = false;

@@ -369,7 +369,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 32] = [
+    let tests: [GpuTest; 33] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -388,6 +388,7 @@ fn main() {
             "a_reduced_resolution_is_the_picture_of_fewer_rays_upscaled",
             interactive::a_reduced_resolution_is_the_picture_of_fewer_rays_upscaled,
         ),
+        ("a_view_at_rest_shows_the_mean_of_its_jittered_frames", interactive::a_view_at_rest_shows_the_mean_of_its_jittered_frames),
         ("context_matches_the_reference", context::context_matches_the_reference),
         ("kappa_t_zero_is_dvr_on_the_gpu", context::kappa_t_zero_is_dvr_on_the_gpu),
         ("clipping_matches_the_reference", clip::clipping_matches_the_reference),

@@ -41,6 +41,29 @@ pub struct VolumeView {
     pub light: Light,
 }
 
+/// On a view whose picture at rest is averaged over frames of different ray jitter
+/// (`interactive` puts it there): this frame is the `index`-th of the average (0 starts
+/// it anew) and weighs `1 / (index + 1)` against what was gathered, so after `frames`
+/// frames the picture is their mean; from then on it is held (no rays are cast, the
+/// average is drawn). The view's [`VolumeView::frame`] seeds each frame's jitter.
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Accumulate {
+    pub index: u32,
+    pub frames: u32,
+}
+
+impl Accumulate {
+    /// The weight of this frame against the frames before it.
+    pub fn weight(&self) -> f32 {
+        1.0 / (self.index as f32 + 1.0)
+    }
+
+    /// Whether the average is complete: the frame casts no rays and shows it.
+    pub fn holds(&self) -> bool {
+        self.index >= self.frames
+    }
+}
+
 impl VolumeView {
     /// [`Self::resolution`] as the renderer takes it: within [`MIN_RESOLUTION`] … 1, and
     /// 1 where it is not a number.

@@ -3,19 +3,35 @@
 use bevy::prelude::*;
 
 use super::view::{InteractiveResolution, Shown};
+use crate::dataset::view::Accumulate;
 use crate::dataset::{SceneRegions, VolumeView};
 use crate::lens::systems::ViewLenses;
+use crate::streaming::bricked::StreamStatus;
+
+/// What the system reads and sets of a view.
+type AdaptedView = (
+    Entity,
+    &'static mut InteractiveResolution,
+    &'static mut VolumeView,
+    &'static GlobalTransform,
+    &'static Camera,
+    Option<&'static ViewLenses>,
+    Option<&'static Accumulate>,
+);
 
 /// Sets [`VolumeView::resolution`] of every view with an enabled
 /// [`InteractiveResolution`] from the frame just measured (`Time<Real>`'s delta) and
-/// whether what it shows changed.
+/// whether what it shows changed; at rest at every pixel, averages jittered frames
+/// ([`Accumulate`], each frame's jitter seeded by its index).
 pub fn adapt_resolution(
+    mut commands: Commands,
     time: Res<Time<Real>>,
     regions: Res<SceneRegions>,
-    mut views: Query<(&mut InteractiveResolution, &mut VolumeView, &GlobalTransform, &Camera, Option<&ViewLenses>)>,
+    streaming: Option<Res<StreamStatus>>,
+    mut views: Query<AdaptedView>,
 ) {
     let frame_ms = time.delta_secs() * 1000.0;
-    for (mut adapt, mut view, transform, camera, lenses) in &mut views {
+    for (entity, mut adapt, mut view, transform, camera, lenses, accumulating) in &mut views {
         let shown = Shown {
             camera: transform.to_matrix(),
             projection: camera.clip_from_view(),
@@ -37,6 +53,27 @@ pub fn adapt_resolution(
         }
         if view.resolution != scale {
             view.resolution = scale;
+        }
+        // (Bricks arriving change the picture of a view at rest: its average starts anew.)
+        let counts = streaming.as_ref().map(|s| s.counts());
+        let state = adapt.bypass_change_detection();
+        if state.last_stream != counts {
+            state.last_stream = counts;
+            state.still_frames = 0;
+        }
+        match state.accumulation(view.jitter) {
+            Some(a) => {
+                if view.frame != a.index {
+                    view.frame = a.index;
+                }
+                commands.entity(entity).insert(a);
+            }
+            None => {
+                if accumulating.is_some() {
+                    commands.entity(entity).remove::<Accumulate>();
+                    view.frame = 0;
+                }
+            }
         }
     }
 }

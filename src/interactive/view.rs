@@ -26,6 +26,14 @@ pub struct InteractiveResolution {
     pub moving: bool,
     /// Milliseconds since what the view shows last changed.
     pub since_change_ms: f32,
+    /// Frames of different ray jitter averaged into the picture at rest (at every
+    /// pixel; 1: none), [`crate::dataset::view::Accumulate`].
+    pub accumulate: u32,
+    /// Frames drawn at rest at every pixel since the view last moved (or streamed
+    /// bricks changed the picture).
+    pub still_frames: u32,
+    /// The streaming counts of the last frame: when they change, the average starts anew.
+    pub last_stream: Option<crate::streaming::bricked::StreamCounts>,
     /// What the view showed last frame.
     pub last: Option<Shown>,
 }
@@ -41,12 +49,27 @@ impl Default for InteractiveResolution {
             moving_scale: 0.5,
             moving: false,
             since_change_ms: f32::INFINITY,
+            accumulate: 16,
+            still_frames: 0,
+            last_stream: None,
             last: None,
         }
     }
 }
 
 impl InteractiveResolution {
+    /// The frame of the average over jittered frames this one is, once the view rests at
+    /// every pixel (counting the frames there), else `None` (and the count starts anew).
+    pub fn accumulation(&mut self, jitter: bool) -> Option<crate::dataset::view::Accumulate> {
+        if !self.enabled || self.moving || self.scale < 1.0 || self.accumulate < 2 || !jitter {
+            self.still_frames = 0;
+            return None;
+        }
+        let index = self.still_frames;
+        self.still_frames = self.still_frames.saturating_add(1);
+        Some(crate::dataset::view::Accumulate { index, frames: self.accumulate })
+    }
+
     /// One frame of the state machine: the scale to draw and whether the view moves.
     pub fn step(&mut self, changed: bool, frame_ms: f32) -> (f32, bool) {
         if !self.enabled {

@@ -62,6 +62,19 @@ pub fn render(scene: &RenderScene, camera: &Camera, width: u32, height: u32) -> 
 
 /// Renders `scene` seen by `camera` through `lenses` (in order, the last on top).
 pub fn render_lensed(scene: &RenderScene, camera: &Camera, lenses: &[Lens], width: u32, height: u32) -> Result<RenderedImage, String> {
+    render_frame(scene, camera, lenses, width, height, 0)
+}
+
+/// [`render_lensed`] with the ray jitter of frame `frame` (the seed of
+/// [`trace::jitter`], as the GPU's `VolumeView::frame`), where the scene jitters.
+pub fn render_frame(
+    scene: &RenderScene,
+    camera: &Camera,
+    lenses: &[Lens],
+    width: u32,
+    height: u32,
+    frame: u32,
+) -> Result<RenderedImage, String> {
     if width == 0 || height == 0 {
         return Err(format!("image size {width}×{height} is empty"));
     }
@@ -81,7 +94,7 @@ pub fn render_lensed(scene: &RenderScene, camera: &Camera, lenses: &[Lens], widt
                 let Some(ray) = lens_ray(camera, screen, resolved, x as f32 + 0.5, y as f32 + 0.5) else {
                     return Traced::EMPTY;
                 };
-                let j = if scene.jitter { trace::jitter(x, y, 0) } else { 0.5 };
+                let j = if scene.jitter { trace::jitter(x, y, frame) } else { 0.5 };
                 let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
                 let footprint = if scene.lens_antialias { Footprint::new(camera, screen, resolved, px, py) } else { None };
                 trace::trace_antialiased(regions, scene.light, ray, j, DEPTH_THRESHOLD, false, footprint.as_ref())

@@ -7,12 +7,27 @@ use bevy::render::render_resource::TextureUsages;
 use bevy::render::sync_component::SyncComponent;
 
 use super::gpu_types::{GpuSettings, view_flags};
+use crate::dataset::view::Accumulate;
 use crate::dataset::{SceneRegions, VolumeView};
 use crate::region::{Light, RenderScene};
 use crate::streaming::bricked::{BrickFrame, BrickedScene, StreamBudget};
 
 impl SyncComponent for VolumeView {
     type Target = GpuSettings;
+}
+
+impl SyncComponent for Accumulate {
+    type Target = Accumulate;
+}
+
+impl ExtractComponent for Accumulate {
+    type QueryData = &'static Accumulate;
+    type QueryFilter = With<Camera3d>;
+    type Out = Accumulate;
+
+    fn extract_component(a: &Accumulate) -> Option<Accumulate> {
+        Some(*a)
+    }
 }
 
 impl ExtractComponent for VolumeView {

@@ -58,6 +58,7 @@ impl Plugin for VolumeRenderPlugin {
             .add_plugins((
                 ExtractComponentPlugin::<VolumeView>::default(),
                 ExtractComponentPlugin::<crate::lens::ViewLenses>::default(),
+                ExtractComponentPlugin::<crate::dataset::view::Accumulate>::default(),
                 UniformComponentPlugin::<GpuSettings>::default(),
             ))
             .add_systems(PostUpdate, (extract::request_depth_binding, fit_datasets.before(crate::dataset::RegionSystems::Collect)));

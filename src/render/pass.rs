@@ -11,8 +11,9 @@ use bevy::render::view::{ViewDepthTexture, ViewTarget, ViewUniformOffset, ViewUn
 use super::feature_pass::{FeatureBuffers, FeaturePipelines, encode_feature_passes};
 use super::gpu_types::GpuSettings;
 use super::pipeline::{RaycastPipeline, RaycastPipelineId};
-use super::reduced::{ReducedTarget, UpscalePipeline, UpscalePipelineId};
+use super::reduced::{AccumulatePipelineId, AccumulationTarget, ReducedTarget, UpscalePipeline, UpscalePipelineId};
 use super::upload::GpuScene;
+use crate::dataset::view::Accumulate;
 
 // A Bevy system: its parameters are the resources and queries it uses, and a query's
 // type names the components it reads; splitting them up would only hide that.
@@ -27,6 +28,7 @@ pub fn raycast_pass(
         Option<&ExtractedCamera>,
         Option<&FeatureBuffers>,
         Option<(&ReducedTarget, &UpscalePipelineId)>,
+        Option<(&AccumulationTarget, &AccumulatePipelineId, &Accumulate)>,
     )>,
     pipeline: Res<RaycastPipeline>,
     upscale: Res<UpscalePipeline>,
@@ -39,7 +41,7 @@ pub fn raycast_pass(
     progress: Res<super::progress::RenderProgress>,
     mut ctx: RenderContext,
 ) {
-    let (target, depth, view_offset, settings_index, pipeline_id, camera, fields, reduced) = view.into_inner();
+    let (target, depth, view_offset, settings_index, pipeline_id, camera, fields, reduced, accumulation) = view.into_inner();
     if scene.region_count == 0 || !scene.ready() {
         return;
     }
@@ -83,9 +85,13 @@ pub fn raycast_pass(
     // the whole of it), then that texture over the view (at full resolution until the
     // upscale pipeline is ready).
     let upscaled = reduced.and_then(|(reduced, id)| Some((reduced, cache.get_render_pipeline(id.0)?)));
+    // An averaging view: this frame into the average with its weight (none once the
+    // average is complete and held), then the average over the view.
+    let averaged = upscaled.and(accumulation.and_then(|(a, id, frame)| Some((a, cache.get_render_pipeline(id.0)?, frame))));
+    let hold = averaged.is_some_and(|(.., frame)| frame.holds());
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
-    {
+    if !hold {
         let (view, load) = match upscaled {
             Some((reduced, _)) => (&reduced.texture.default_view, LoadOp::Clear(Default::default())),
             None => (target.main_texture_view(), LoadOp::Load),
@@ -113,34 +119,71 @@ pub fn raycast_pass(
         span.end(&mut pass);
     }
     if let Some((reduced, upscale_pipeline)) = upscaled {
-        let bind_group = ctx.render_device().create_bind_group(
-            "focal_upscale_bind_group",
-            &cache.get_bind_group_layout(&upscale.layout),
-            &BindGroupEntries::sequential((&reduced.texture.default_view, &upscale.sampler)),
-        );
-        let mut pass = ctx.command_encoder().begin_render_pass(&RenderPassDescriptor {
-            label: Some("focal_upscale_pass"),
-            color_attachments: &[Some(RenderPassColorAttachment {
-                view: target.main_texture_view(),
-                depth_slice: None,
-                resolve_target: None,
-                ops: Operations { load: LoadOp::Load, store: StoreOp::Store },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        if let Some([x, y, w, h, near, far]) = camera_viewport(camera) {
-            pass.set_viewport(x, y, w, h, near, far);
+        let mut source = &reduced.texture.default_view;
+        if let Some((average, average_pipeline, frame)) = averaged {
+            if !hold {
+                let into =
+                    Drawn { source, target: &average.view, pipeline: average_pipeline, viewport: None, weight: Some(frame.weight()) };
+                draw_texture(&mut ctx, &upscale, &cache, into, "focal_accumulate");
+            }
+            source = &average.view;
         }
-        let span = diagnostics.pass_span(&mut pass, "focal_upscale");
-        pass.set_pipeline(upscale_pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.draw(0..3, 0..1);
-        span.end(&mut pass);
+        let over = Drawn {
+            source,
+            target: target.main_texture_view(),
+            pipeline: upscale_pipeline,
+            viewport: camera_viewport(camera),
+            weight: None,
+        };
+        draw_texture(&mut ctx, &upscale, &cache, over, "focal_upscale");
     }
     progress.count_draw();
+}
+
+/// A texture drawn onto another by the upscale pipeline.
+struct Drawn<'a> {
+    source: &'a TextureView,
+    target: &'a TextureView,
+    pipeline: &'a RenderPipeline,
+    /// Where on the target (the whole of it when `None`).
+    viewport: Option<[f32; 6]>,
+    /// The blend constant of a weighted average.
+    weight: Option<f32>,
+}
+
+/// Draws `drawn.source` over (or into) `drawn.target`, timed as `label`.
+fn draw_texture(ctx: &mut RenderContext, upscale: &UpscalePipeline, cache: &PipelineCache, drawn: Drawn, label: &'static str) {
+    let bind_group = ctx.render_device().create_bind_group(
+        "focal_upscale_bind_group",
+        &cache.get_bind_group_layout(&upscale.layout),
+        &BindGroupEntries::sequential((drawn.source, &upscale.sampler)),
+    );
+    let diagnostics = ctx.diagnostic_recorder();
+    let diagnostics = diagnostics.as_deref();
+    let mut pass = ctx.command_encoder().begin_render_pass(&RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(RenderPassColorAttachment {
+            view: drawn.target,
+            depth_slice: None,
+            resolve_target: None,
+            ops: Operations { load: LoadOp::Load, store: StoreOp::Store },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    if let Some([x, y, w, h, near, far]) = drawn.viewport {
+        pass.set_viewport(x, y, w, h, near, far);
+    }
+    if let Some(w) = drawn.weight {
+        pass.set_blend_constant(LinearRgba::new(w, w, w, w).into());
+    }
+    let span = diagnostics.pass_span(&mut pass, label);
+    pass.set_pipeline(drawn.pipeline);
+    pass.set_bind_group(0, &bind_group, &[]);
+    pass.draw(0..3, 0..1);
+    span.end(&mut pass);
 }
 
 /// The viewport of a camera limited to part of its target (the app's viewport beside

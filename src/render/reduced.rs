@@ -8,6 +8,12 @@
 //! from the pixels drawn (`pixel_steps` in `shaders/focal/lens.wgsl`), so bricked
 //! volumes step at the level those pixels need, and the scene depth from the view's
 //! own pixel under each one's centre.
+//!
+//! A view that averages jittered frames at rest ([`Accumulate`]) also draws its rays
+//! into such a texture (at every pixel), which is blended into its
+//! [`AccumulationTarget`] (half floats, kept from frame to frame) with the frame's
+//! weight as the blend constant, `a ← w·c + (1 − w)·a`; the average is then drawn over
+//! the view.
 
 use bevy::core_pipeline::FullscreenShader;
 use bevy::prelude::*;
@@ -19,6 +25,10 @@ use bevy::render::texture::{CachedTexture, TextureCache};
 use bevy::render::view::{ExtractedView, ViewTarget};
 
 use super::gpu_types::GpuSettings;
+use crate::dataset::view::Accumulate;
+
+/// The format of the averages of jittered frames.
+pub const ACCUMULATION_FORMAT: TextureFormat = TextureFormat::Rgba16Float;
 
 /// The size in pixels a view of `viewport` pixels draws its rays at for `resolution`
 /// (rounded up, at least one pixel; the view's own size at 1 or above).
@@ -29,12 +39,24 @@ pub fn reduced_size(viewport: UVec2, resolution: f32) -> UVec2 {
     (viewport.as_vec2() * resolution.max(0.0)).ceil().as_uvec2().max(UVec2::ONE).min(viewport.max(UVec2::ONE))
 }
 
-/// The texture a reduced-resolution view's rays are drawn into.
+/// The texture a reduced-resolution (or accumulating) view's rays are drawn into.
 #[derive(Component)]
 pub struct ReducedTarget {
     pub texture: CachedTexture,
     pub size: UVec2,
 }
+
+/// The average of an accumulating view's jittered frames, kept between frames.
+#[derive(Component)]
+pub struct AccumulationTarget {
+    pub texture: Texture,
+    pub view: TextureView,
+    pub size: UVec2,
+}
+
+/// The pipeline that blends a view's rays into its [`AccumulationTarget`].
+#[derive(Component)]
+pub struct AccumulatePipelineId(pub CachedRenderPipelineId);
 
 /// The pass that draws a [`ReducedTarget`] over its view.
 #[derive(Resource)]
@@ -63,22 +85,32 @@ pub fn init_upscale_pipeline(mut commands: Commands, device: Res<RenderDevice>, 
     commands.insert_resource(UpscalePipeline { layout, sampler, fullscreen: fullscreen.clone() });
 }
 
-impl SpecializedRenderPipeline for UpscalePipeline {
-    /// The view's colour format.
-    type Key = TextureFormat;
+/// How the upscale pass blends: "over" the view, or into an average with the frame's
+/// weight as the blend constant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Blend {
+    Over,
+    Average,
+}
 
-    fn specialize(&self, format: TextureFormat) -> RenderPipelineDescriptor {
+impl SpecializedRenderPipeline for UpscalePipeline {
+    /// The target's colour format and the blending.
+    type Key = (TextureFormat, Blend);
+
+    fn specialize(&self, (format, blend): (TextureFormat, Blend)) -> RenderPipelineDescriptor {
+        let weighted =
+            BlendComponent { src_factor: BlendFactor::Constant, dst_factor: BlendFactor::OneMinusConstant, operation: BlendOperation::Add };
+        let blend = match blend {
+            Blend::Over => BlendState::PREMULTIPLIED_ALPHA_BLENDING,
+            Blend::Average => BlendState { color: weighted, alpha: weighted },
+        };
         RenderPipelineDescriptor {
             label: Some("focal_upscale_pipeline".into()),
             layout: vec![self.layout.clone()],
             vertex: self.fullscreen.to_vertex_state(),
             fragment: Some(FragmentState {
                 shader: super::shaders::UPSCALE,
-                targets: vec![Some(ColorTargetState {
-                    format,
-                    blend: Some(BlendState::PREMULTIPLIED_ALPHA_BLENDING),
-                    write_mask: ColorWrites::ALL,
-                })],
+                targets: vec![Some(ColorTargetState { format, blend: Some(blend), write_mask: ColorWrites::ALL })],
                 ..default()
             }),
             ..default()
@@ -90,9 +122,12 @@ impl SpecializedRenderPipeline for UpscalePipeline {
 #[derive(Component)]
 pub struct UpscalePipelineId(pub CachedRenderPipelineId);
 
-/// Gives every view drawn at a reduced resolution its [`ReducedTarget`] (of the view's
-/// colour format, so the ray caster's pipeline for the view draws into it) and its
-/// upscale pipeline, and takes them from views drawn at full resolution.
+/// Gives every view drawn at a reduced resolution, or averaging jittered frames, its
+/// [`ReducedTarget`] (of the view's colour format, so the ray caster's pipeline for the
+/// view draws into it) and its upscale pipeline, and an averaging view its
+/// [`AccumulationTarget`] and the pipeline into it; takes them from the others.
+// A Bevy system: its parameters are the resources and queries it uses.
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn prepare_reduced_targets(
     mut commands: Commands,
     mut textures: ResMut<TextureCache>,
@@ -100,31 +135,48 @@ pub fn prepare_reduced_targets(
     cache: Res<PipelineCache>,
     mut pipelines: ResMut<SpecializedRenderPipelines<UpscalePipeline>>,
     pipeline: Res<UpscalePipeline>,
-    views: Query<(Entity, &ExtractedCamera, &ViewTarget, &GpuSettings), With<ExtractedView>>,
+    views: Query<
+        (Entity, &ExtractedCamera, &ViewTarget, &GpuSettings, Option<&Accumulate>, Option<&AccumulationTarget>),
+        With<ExtractedView>,
+    >,
 ) {
-    for (entity, camera, target, settings) in &views {
+    for (entity, camera, target, settings, accumulate, kept) in &views {
         let viewport = camera.physical_viewport_size.unwrap_or(UVec2::ONE);
         let size = reduced_size(viewport, settings.resolution);
-        if size == viewport {
-            commands.entity(entity).remove::<(ReducedTarget, UpscalePipelineId)>();
-            continue;
+        if accumulate.is_none() {
+            commands.entity(entity).remove::<(AccumulationTarget, AccumulatePipelineId)>();
+            if size == viewport {
+                commands.entity(entity).remove::<(ReducedTarget, UpscalePipelineId)>();
+                continue;
+            }
         }
         let format = target.main_texture_format();
-        let texture = textures.get(
-            &device,
-            TextureDescriptor {
-                label: Some("focal_reduced_rays"),
-                size: Extent3d { width: size.x, height: size.y, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: TextureDimension::D2,
-                format,
-                usage: TextureUsages::RENDER_ATTACHMENT | TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-        );
-        let id = pipelines.specialize(&cache, &pipeline, format);
+        let texture = textures.get(&device, target_descriptor("focal_reduced_rays", size, format));
+        let id = pipelines.specialize(&cache, &pipeline, (format, Blend::Over));
         commands.entity(entity).insert((ReducedTarget { texture, size }, UpscalePipelineId(id)));
+        if accumulate.is_some() {
+            if kept.is_none_or(|k| k.size != size) {
+                let texture = device.create_texture(&target_descriptor("focal_accumulated_rays", size, ACCUMULATION_FORMAT));
+                let view = texture.create_view(&TextureViewDescriptor::default());
+                commands.entity(entity).insert(AccumulationTarget { texture, view, size });
+            }
+            let id = pipelines.specialize(&cache, &pipeline, (ACCUMULATION_FORMAT, Blend::Average));
+            commands.entity(entity).insert(AccumulatePipelineId(id));
+        }
+    }
+}
+
+/// A 2D texture the rays are drawn into and then sampled.
+fn target_descriptor(label: &'static str, size: UVec2, format: TextureFormat) -> TextureDescriptor<'static> {
+    TextureDescriptor {
+        label: Some(label),
+        size: Extent3d { width: size.x, height: size.y, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: TextureDimension::D2,
+        format,
+        usage: TextureUsages::RENDER_ATTACHMENT | TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
     }
 }
 

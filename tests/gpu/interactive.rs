@@ -74,3 +74,47 @@ pub fn a_reduced_resolution_is_the_picture_of_fewer_rays_upscaled(gpu: &mut Gpu)
         assert!((c.0 - c_full.0).abs() < 0.5 && (c.1 - c_full.1).abs() < 0.5, "centre {c:?} against {c_full:?}");
     }
 }
+
+/// At rest at every pixel, the app's view averages frames of different ray jitter
+/// (`dataset::view::Accumulate`, put there by `interactive`): after its 8 frames the
+/// picture is the mean of the CPU reference's pictures with the jitter of frames 0 … 7,
+/// and it is held (no new rays change it).
+pub fn a_view_at_rest_shows_the_mean_of_its_jittered_frames(gpu: &mut Gpu) {
+    use focal::dataset::view::Accumulate;
+    use focal::interactive::InteractiveResolution;
+    let h = head();
+    // Samples 3 voxels apart: each jittered frame is noisy, their mean much less so.
+    let look = Appearance { step: 3.0, ..Appearance::new(Mode::Dvr, presets::builtin("ct_bone").unwrap()) };
+    let cam = framed(&h, View::Oblique, false);
+    gpu.show(h.clone(), look.clone(), &cam);
+    let jittered = VolumeView { jitter: true, ..Default::default() };
+    gpu.off.set_view(jittered);
+    let single = gpu.off.capture().unwrap_or_else(|e| panic!("{e}"));
+    let camera = gpu.off.camera();
+    const FRAMES: u32 = 8;
+    gpu.off.world_mut().entity_mut(camera).insert(InteractiveResolution { accumulate: FRAMES, ..Default::default() });
+    for _ in 0..FRAMES + 2 {
+        gpu.off.update();
+    }
+    let index = gpu.off.world_mut().get::<Accumulate>(camera).map(|a| a.index);
+    let averaged = gpu.off.capture().unwrap_or_else(|e| panic!("{e}"));
+    let held = gpu.off.capture().unwrap_or_else(|e| panic!("{e}"));
+    gpu.off.world_mut().entity_mut(camera).remove::<(InteractiveResolution, Accumulate)>();
+    gpu.off.set_view(VolumeView { jitter: false, ..Default::default() });
+    assert!(index.is_some_and(|i| i >= FRAMES), "the view does not average at rest: {index:?}");
+    // The mean of the reference's jittered pictures, in linear light.
+    let scene = RenderScene { jitter: true, ..RenderScene::single(h, look) };
+    let frames: Vec<_> = (0..FRAMES).map(|f| focal::reference::render_frame(&scene, &cam, &[], SIZE, SIZE, f).unwrap()).collect();
+    let encode = |v: f32| (focal::transfer::color::linear_to_srgb(v).clamp(0.0, 1.0) * 255.0).round() as u8;
+    let mean = image::RgbaImage::from_fn(SIZE, SIZE, |x, y| {
+        let c = frames.iter().map(|f| f.at(x, y)).sum::<glam::Vec4>() / FRAMES as f32;
+        image::Rgba([encode(c.x), encode(c.y), encode(c.z), 255])
+    });
+    assert_matches("accumulated-8", &averaged, &mean);
+    assert_eq!(difference(&averaged, &held).2, 0, "the held average changed");
+    // One jittered frame is further from the mean: the average did something.
+    let (one, _, _) = difference(&single, &mean);
+    let (all, _, _) = difference(&averaged, &mean);
+    println!("    against the mean of 8 jittered frames: one frame {one:.3}, the average {all:.3} levels");
+    assert!(one > 2.0 * all + 0.1, "one frame {one} against the average {all}");
+}

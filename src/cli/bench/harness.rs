@@ -25,6 +25,8 @@ pub(super) struct Row {
     /// Half the interquartile range of the ratio over the rounds (each round's frame
     /// against the baseline's of the same round), where timed in rounds.
     pub(super) spread: Option<f64>,
+    /// The ray caster's passes on the GPU, ms per frame (timestamp queries).
+    pub(super) gpu_ms: Option<f64>,
     pub(super) note: String,
 }
 
@@ -67,6 +69,9 @@ pub(super) struct Bench {
     pub(super) count_images: Vec<image::RgbaImage>,
     /// Each configuration's ratio against the first of the last [`Self::rounds`].
     pub(super) paired: Vec<Paired>,
+    /// Each configuration's ray-cast pass time on the GPU, where the adapter has
+    /// timestamp queries ([`Self::gpu_pass_ms`]).
+    pub(super) gpu_ms: Vec<Option<f64>>,
 }
 
 impl Bench {
@@ -174,12 +179,7 @@ impl Bench {
                 let t = self.off.time_frames_with(1, |off, _| {
                     if orbit {
                         turn += 1;
-                        let q = Quat::from_rotation_y(turn as f32 * 0.5f32.to_radians());
-                        off.set_camera(&focal::region::Camera {
-                            position: centre + q * (camera.position - centre),
-                            rotation: q * camera.rotation,
-                            ..camera
-                        });
+                        off.set_camera(&orbited(&camera, centre, turn));
                     }
                 });
                 if round > 0 {
@@ -188,6 +188,12 @@ impl Bench {
             }
         }
         self.paired = times.iter().map(|v| Paired::of(v.iter().zip(&times[0]).map(|(t, base)| t / base.max(1e-9)).collect())).collect();
+        self.gpu_ms = (0..count)
+            .map(|i| {
+                set(&mut self.off, i);
+                self.gpu_pass_ms()
+            })
+            .collect();
         if std::env::var_os("FOCAL_BENCH_SAMPLES").is_some() {
             for (i, v) in times.iter().enumerate() {
                 eprintln!("config {i}: {}", v.iter().map(|t| format!("{t:.0}")).collect::<Vec<_>>().join(" "));
@@ -223,6 +229,49 @@ impl Bench {
             })
             .collect()
     }
+}
+
+/// The passes of the ray caster, as `render::pass` names their diagnostics spans.
+const PASSES: [&str; 2] = ["focal_raycast", "focal_upscale"];
+
+/// Frames each configuration runs for its GPU pass times: the first half is left out
+/// (read back late, their times may be the previous configuration's).
+const GPU_FRAMES: usize = 6;
+
+impl Bench {
+    /// The GPU time of the ray caster's passes in the view as it is now (the median over
+    /// the second half of [`GPU_FRAMES`] frames), from Bevy's render diagnostics
+    /// (timestamp queries); `None` where the adapter has none.
+    pub(super) fn gpu_pass_ms(&mut self) -> Option<f64> {
+        use bevy::diagnostic::{DiagnosticPath, DiagnosticsStore};
+        // (A pass's last measurement stays in the store after the pass is gone: only
+        // those taken since this configuration began count.)
+        for _ in 0..GPU_FRAMES / 2 {
+            self.off.update();
+        }
+        let start = std::time::Instant::now();
+        let mut each = Vec::new();
+        for _ in 0..GPU_FRAMES / 2 {
+            self.off.update();
+            let store = self.off.world_mut().get_resource::<DiagnosticsStore>()?;
+            let fresh: Vec<f64> = PASSES
+                .iter()
+                .filter_map(|p| store.get(&DiagnosticPath::new(format!("render/{p}/elapsed_gpu"))))
+                .filter_map(|d| d.measurement().filter(|m| m.time >= start).map(|m| m.value))
+                .collect();
+            each.push((!fresh.is_empty()).then(|| fresh.iter().sum::<f64>()));
+        }
+        let mut last: Vec<f64> = each.into_iter().flatten().collect();
+        last.sort_by(f64::total_cmp);
+        last.get(last.len() / 2).copied()
+    }
+}
+
+/// `camera` turned `turn` half degrees about the vertical through `centre` (the bench's
+/// orbit: what depends on the camera is recomputed every frame).
+pub(super) fn orbited(camera: &focal::region::Camera, centre: Vec3, turn: u32) -> focal::region::Camera {
+    let q = Quat::from_rotation_y(turn as f32 * 0.5f32.to_radians());
+    focal::region::Camera { position: centre + q * (camera.position - centre), rotation: q * camera.rotation, ..*camera }
 }
 
 /// Names of configurations.
@@ -277,6 +326,7 @@ pub(super) fn push_group(rows: &mut Vec<Row>, bench: &Bench, group: &'static str
             ratio: bench.paired.get(i).map_or(t / ms[0].max(1e-9), |p| p.ratio),
             sample_ratio: base_samples.zip(bench.counts.get(i)).map(|(b, c)| c.samples as f64 / b.max(1) as f64),
             spread: bench.paired.get(i).map(|p| p.spread),
+            gpu_ms: bench.gpu_ms.get(i).copied().flatten(),
             note: note.into(),
         });
     }

@@ -13,7 +13,7 @@ use focal::region::{Appearance, Mode};
 use focal::transfer::presets;
 use focal::volume::phantom::Phantom;
 
-use super::harness::{Bench, Row, names, push_group};
+use super::harness::{Bench, Row, names, orbited, push_group};
 
 /// Frames the adaptive row orbits before it is timed (the controller settles), and
 /// timed.
@@ -36,6 +36,7 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> 
     let (ms, images) = bench.interleaved(ct, look, &configs, true)?;
     bench.save_images("interactive", &images)?;
     let full = ms[0];
+    let first = rows.len();
     push_group(
         rows,
         bench,
@@ -45,6 +46,11 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> 
         "head phantom, CT skin + bone, orbiting",
         "rays drawn at a fraction of the pixels per axis, upscaled",
     );
+    // (Samples are counted per pixel of the view, at full resolution: the reduced rows
+    // draw a quarter and a sixteenth of the rays.)
+    for row in rows.iter_mut().skip(first + 1) {
+        row.sample_ratio = None;
+    }
 
     // The app's adaptive resolution, orbiting on its own (it follows the frames it
     // measures, so it is not interleaved with the fixed ones).
@@ -56,12 +62,7 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> 
     let mut turn = 0u32;
     let mut orbit = |off: &mut focal::render::headless::Offscreen| {
         turn += 1;
-        let q = Quat::from_rotation_y(turn as f32 * 0.5f32.to_radians());
-        off.set_camera(&focal::region::Camera {
-            position: centre + q * (camera.position - centre),
-            rotation: q * camera.rotation,
-            ..camera
-        });
+        off.set_camera(&orbited(&camera, centre, turn));
     };
     for _ in 0..SETTLE {
         orbit(&mut bench.off);
@@ -90,6 +91,7 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> 
         ratio: median / full.max(1e-9),
         sample_ratio: None,
         spread: None,
+        gpu_ms: None,
         note: format!(
             "median frame {median:.1} ms against the {target:.0} ms it holds; settled at {:.0} % of the pixels per axis (range {:.0}–{:.0} %)",
             scale * 100.0,

@@ -124,7 +124,9 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         || args.bricked
         || args.interactive);
     let off = Offscreen::new(w, h, |app| {
-        app.add_plugins(FocalPlugins);
+        // (Render diagnostics: each pass's GPU time, where the adapter has timestamp
+        // queries.)
+        app.add_plugins((FocalPlugins, bevy::render::diagnostic::RenderDiagnosticsPlugin));
     })?;
     eprintln!("GPU: {}  image {w}×{h}, {} rounds", off.adapter_name(), args.frames);
     let mut bench = Bench {
@@ -135,6 +137,7 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         counts: Vec::new(),
         count_images: Vec::new(),
         paired: Vec::new(),
+        gpu_ms: Vec::new(),
     };
     let still = VolumeView { jitter: false, ..Default::default() };
     let mut rows = Vec::new();
@@ -318,16 +321,17 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         let v: Vec<_> =
             rows
             .iter()
-            .map(|r| json!({"group": r.group, "config": r.config, "ms_per_frame": r.ms, "baseline": r.baseline, "ratio": r.ratio, "frame_rate_percent": r.frame_rate_percent(), "sample_ratio": r.sample_ratio, "ratio_spread": r.spread, "note": r.note}))
+            .map(|r| json!({"group": r.group, "config": r.config, "ms_per_frame": r.ms, "baseline": r.baseline, "ratio": r.ratio, "frame_rate_percent": r.frame_rate_percent(), "sample_ratio": r.sample_ratio, "ratio_spread": r.spread, "gpu_pass_ms": r.gpu_ms, "note": r.note}))
             .collect();
         println!("{}", serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?);
     } else {
         for r in &rows {
             let samples = r.sample_ratio.map_or(String::new(), |s| format!(", its picture ×{s:.2} the samples"));
             let spread = r.spread.map_or(String::new(), |s| format!(" ±{s:.2}"));
+            let gpu = r.gpu_ms.map_or(String::new(), |g| format!(", rays {g:.1} ms on the GPU"));
             let note = if r.note.is_empty() { String::new() } else { format!("  ({})", r.note) };
             println!(
-                "{:<12} {:<16} {:>9.1} ms/frame  ×{:.2}{spread} vs {} ({:.0} % of its frame rate{samples}){note}",
+                "{:<12} {:<16} {:>9.1} ms/frame  ×{:.2}{spread} vs {} ({:.0} % of its frame rate{samples}{gpu}){note}",
                 r.group,
                 r.config,
                 r.ms,
