@@ -271,6 +271,16 @@ fn a_moving_view_draws_fewer_pixels_and_refines_at_rest() {
     app.update();
     assert_eq!(accumulated(&app), Some(before + 2));
     assert_eq!(seed(&app), Some(before + 2));
+    // A switch of the view turned at rest is a change too: the average starts anew.
+    if let Some(mut v) = app.world_mut().get_mut::<VolumeView>(camera) {
+        v.skip_empty = false;
+    }
+    app.update();
+    assert_eq!(accumulated(&app), None, "a switch turned at rest kept the old average");
+    for _ in 0..8 {
+        app.update();
+    }
+    assert!(accumulated(&app).is_some(), "no average at rest after the switch");
     // Moving again: no average, the seed back to 0.
     if let Some(mut t) = app.world_mut().get_mut::<Transform>(camera) {
         t.translation.x += 5.0;

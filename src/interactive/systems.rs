@@ -35,6 +35,8 @@ pub fn adapt_resolution(
         let shown = Shown {
             camera: transform.to_matrix(),
             projection: camera.clip_from_view(),
+            pixels: camera.physical_viewport_size(),
+            switches: VolumeView { resolution: 1.0, frame: 0, ..*view },
             lenses: lenses.cloned(),
             scene: regions.scene.clone(),
         };

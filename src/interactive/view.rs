@@ -96,6 +96,11 @@ impl InteractiveResolution {
 pub struct Shown {
     pub camera: Mat4,
     pub projection: Mat4,
+    /// The view's pixels (a resized viewport of the same aspect keeps its projection).
+    pub pixels: Option<UVec2>,
+    /// The view's switches (with the resolution and jitter seed this system sets left
+    /// out): a switch turned at rest starts a new picture.
+    pub switches: crate::dataset::VolumeView,
     pub lenses: Option<ViewLenses>,
     pub scene: RenderScene,
 }

@@ -77,7 +77,7 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> 
         frames.push(t.elapsed().as_secs_f64() * 1000.0);
         scales.push(bench.off.world_mut().get::<VolumeView>(cam_entity).map_or(1.0, |v| v.resolution));
     }
-    bench.off.world_mut().entity_mut(cam_entity).remove::<InteractiveResolution>();
+    bench.off.world_mut().entity_mut(cam_entity).remove::<(InteractiveResolution, focal::dataset::view::Accumulate)>();
     bench.off.set_view(still);
     frames.sort_by(f64::total_cmp);
     scales.sort_by(f32::total_cmp);
