@@ -41,13 +41,19 @@ pub fn adapt_resolution(
             scene: regions.scene.clone(),
         };
         let state = adapt.bypass_change_detection();
-        // (The first frame a view shows is no movement.)
-        let changed = state.last.as_ref().is_some_and(|last| *last != shown);
-        if state.last.as_ref() != Some(&shown) {
+        // (The first frame a view shows is no movement. What is compared is what the
+        // view showed when it last moved, so a slow drift adds up to a movement.)
+        let moved = state.last.as_ref().and_then(|last| shown.what_moved(last));
+        let changed = moved.is_some();
+        if changed || state.last.is_none() {
             state.last = Some(shown);
         }
         let next = state.step(changed, frame_ms);
         let differs = (state.scale, state.moving) != next;
+        if state.moving != next.1 {
+            let what = if next.1 { format!("moving ({})", moved.unwrap_or("")) } else { "at rest".into() };
+            debug!("view {entity}: {what}, rays at {:.0} % of the pixels per axis", next.0 * 100.0);
+        }
         (state.scale, state.moving) = next;
         let scale = state.scale;
         if differs {
