@@ -45,8 +45,11 @@ const GRADIENT_NORMS: u32 = 16u;
 // of level L (set per ray).
 var<private> bricked_step: f32 = 1.0;
 var<private> bricked_gradient_norm: f32 = 1.0;
-// The finest level the ray reads (its footprint's: no data finer than it needs).
+// The finest level c the ray reads (its footprint's: no data finer than it needs, at
+// most the directory's G), and where a block's words of level c start: (2^(G−c))³ of
+// them after 8^G + … + 8^(G−c+1) (page_table::block_offset). Per ray, not per look-up.
 var<private> bricked_cap: u32 = 0u;
+var<private> bricked_block_offset: u32 = 0u;
 
 // Sets the ray's level l (of 0 … C) in bricked region r, and the finest level it reads
 // (`cap`: l, or under a lens with context steps the lens's footprint's level where it is
@@ -54,7 +57,9 @@ var<private> bricked_cap: u32 = 0u;
 fn set_bricked_level(r: Region, l: f32, cap: f32) -> f32 {
     let f = exp2(l - f32(r.bricked.w));
     bricked_step = f;
-    bricked_cap = u32(max(cap, 0.0));
+    let g = r.bricked_dims.w;
+    bricked_cap = min(u32(max(cap, 0.0)), g);
+    bricked_block_offset = ((1u << (3u * (g + 1u))) - (1u << (3u * (g - bricked_cap + 1u)))) / 7u;
     let tree = pages[PAGE_HEADER + r.bricked.x - 1u];
     bricked_gradient_norm = bitcast<f32>(pages[tree - GRADIENT_NORMS + u32(l)]);
     return f;
@@ -107,13 +112,11 @@ fn bricked_locate(r: Region, q0: vec3<f32>) {
     let bg = b0 >> vec3(g);
     let ng = brick_count(level_dims(d0, g), size);
     var word = pages[tree + (bg.z * ng.y + bg.y) * ng.x + bg.x];
-    // (The block's words of level c: (2^(G−c))³ of them after 8^G + … + 8^(G−c+1),
-    // page_table::block_offset.)
-    let c = min(bricked_cap, g);
+    // (The block's words of the ray's level c.)
+    let c = bricked_cap;
     let w = 1u << (g - c);
     let l = (b0 >> vec3(c)) - bg * w;
-    let offset = ((1u << (3u * (g + 1u))) - (1u << (3u * (g - c + 1u)))) / 7u;
-    let in_block = pages[tree + (word & 0x3fffffffu) + offset + (l.z * w + l.y) * w + l.x];
+    let in_block = pages[tree + (word & 0x3fffffffu) + bricked_block_offset + (l.z * w + l.y) * w + l.x];
     word = select(word, in_block, (word >> 30u) == BRICKED_BLOCK);
     let kind = word >> 30u;
     let k = (word >> 26u) & 15u;

@@ -48,23 +48,19 @@ pub fn adapt_resolution(
         if changed || state.last.is_none() {
             state.last = Some(shown);
         }
+        // (Nothing watches this component's changes: the system's own bookkeeping
+        // bypasses them.)
         let next = state.step(changed, frame_ms);
-        let differs = (state.scale, state.moving) != next;
         if state.moving != next.1 {
             let what = if next.1 { format!("moving ({})", moved.unwrap_or("")) } else { "at rest".into() };
             debug!("view {entity}: {what}, rays at {:.0} % of the pixels per axis", next.0 * 100.0);
         }
         (state.scale, state.moving) = next;
-        let scale = state.scale;
-        if differs {
-            adapt.set_changed();
-        }
-        if view.resolution != scale {
-            view.resolution = scale;
+        if view.resolution != state.scale {
+            view.resolution = state.scale;
         }
         // (Bricks arriving change the picture of a view at rest: its average starts anew.)
         let counts = streaming.as_ref().map(|s| s.counts());
-        let state = adapt.bypass_change_detection();
         if state.last_stream != counts {
             state.last_stream = counts;
             state.still_frames = 0;
