@@ -141,6 +141,12 @@ pub fn prepare_reduced_targets(
     >,
 ) {
     for (entity, camera, target, settings, accumulate, kept) in &views {
+        // (Both pipelines are asked for from the view's first frame, so the app's
+        // asynchronous compilation has them ready when the view first moves or rests: a
+        // frame of an average drawn without its pipeline would be missing from it.)
+        let format = target.main_texture_format();
+        let over = pipelines.specialize(&cache, &pipeline, (format, Blend::Over));
+        let average = pipelines.specialize(&cache, &pipeline, (ACCUMULATION_FORMAT, Blend::Average));
         let viewport = camera.physical_viewport_size.unwrap_or(UVec2::ONE);
         let size = reduced_size(viewport, settings.resolution);
         if accumulate.is_none() {
@@ -150,18 +156,15 @@ pub fn prepare_reduced_targets(
                 continue;
             }
         }
-        let format = target.main_texture_format();
         let texture = textures.get(&device, target_descriptor("focal_reduced_rays", size, format));
-        let id = pipelines.specialize(&cache, &pipeline, (format, Blend::Over));
-        commands.entity(entity).insert((ReducedTarget { texture, size }, UpscalePipelineId(id)));
+        commands.entity(entity).insert((ReducedTarget { texture, size }, UpscalePipelineId(over)));
         if accumulate.is_some() {
             if kept.is_none_or(|k| k.size != size) {
                 let texture = device.create_texture(&target_descriptor("focal_accumulated_rays", size, ACCUMULATION_FORMAT));
                 let view = texture.create_view(&TextureViewDescriptor::default());
                 commands.entity(entity).insert(AccumulationTarget { texture, view, size });
             }
-            let id = pipelines.specialize(&cache, &pipeline, (ACCUMULATION_FORMAT, Blend::Average));
-            commands.entity(entity).insert(AccumulatePipelineId(id));
+            commands.entity(entity).insert(AccumulatePipelineId(average));
         }
     }
 }
