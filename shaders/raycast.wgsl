@@ -34,13 +34,13 @@
 #import focal::types::{Region, MODE_TWO_LEVEL, MODE_MIP, MODE_MIN_IP, MODE_ISO, REGION_LABELS, REGION_OCCUPANCY, VIEW_JITTER, VIEW_SKIP_EMPTY, VIEW_EARLY_TERMINATION, VIEW_DEBUG_RAYS, VIEW_DEBUG_COUNTS, EARLY_TERMINATION, MAX_RAY_REGIONS, REGION_CLUSTER}
 #import focal::bindings::{view, settings, scene, regions, depth_texture}
 #import focal::camera::{Ray, pixel_ray, scene_depth_t, jitter}
-#import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod}
+#import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod, level_varies}
 #import focal::regions::{region_interval, hole_interval, meets_sphere, pick_region, to_voxel, dir_to_voxel, world_step}
-#import focal::sampling::{trilinear, brick_occupied, brick_range, at_full_resolution, count_sample, ray_sample_count}
+#import focal::sampling::{trilinear, brick_occupied, brick_range, at_full_resolution, count_sample, ray_sample_count, set_lod}
 #import focal::bricked::page_lookup_count
 #import focal::selection::{region_weight, set_weight, pick_weight, set_companion, no_companion}
 #import focal::samples::{is_projection, dvr_sample, is_dvr_like, iso_hit, emit_projection, projection_takes}
-#import focal::segments::{DONE, HAS_PREV, PAIRABLE, CLOSES, Segment, segment_t, segment_point, past_brick, past_empty_bricks, past_empty_pair, cut_intervals, compact_intervals, leaves}
+#import focal::segments::{DONE, HAS_PREV, PAIRABLE, CLOSES, Segment, segment_t, segment_point, segment_point_at, past_brick, past_empty_bricks, past_empty_bricks_at, past_empty_pair, cut_intervals, compact_intervals, leaves}
 #ifdef HAS_TWO_LEVEL
 #import focal::two_level::{NO_PART, Open, fresh, close_segment, end_segment, two_level_sample, open_part}
 #endif
@@ -408,9 +408,8 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                                     break;
                                 }
                             }
-                            let coarse = !at_full_resolution();
-                            let take_a = !occupancy_a || coarse || brick_occupied(r, segment_point(g, kk));
-                            let take_b = (!occupancy_b || coarse || brick_occupied(rb, gb.q_first + gb.dq * (kk - gb.k_first)));
+                            let take_a = !occupancy_a || brick_occupied(r, segment_point(g, kk));
+                            let take_b = !occupancy_b || brick_occupied(rb, gb.q_first + gb.dq * (kk - gb.k_first));
                             if !take_a && !take_b {
                                 kk += 1.0;
                                 continue;
@@ -441,19 +440,21 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #ifdef COMPANION
                     set_companion(r, ray.origin, ray.dir, step);
 #endif
-                    for (var dvr_steps = 0u; dvr_steps < scene.max_steps; dvr_steps++) {
-                        if kk > k_end || acc.a >= stop {
-                            break;
-                        }
-                        if occupancy {
-                            kk = past_empty_bricks(r, g, kk, k_end);
-                            if kk > k_end {
-                                break;
-                            }
-                        }
-                        acc = dvr_sample(r, segment_point(g, kk), ratios[s], ray, segment_t(g, kk), acc);
-                        kk += 1.0;
+#ifdef LENS_ANTIALIAS
+                    // Rays whose level is 0 all along (all but the compressed ones) take
+                    // a copy of the loop in which it is the constant 0: one fetch per
+                    // sample instead of the two levels' blend and no level per sample
+                    // (llvmpipe runs both sides of the `if`, but a loop no lane is in
+                    // only once; the lens code with anti-aliasing cost ×1.75 without it).
+                    if level_varies() {
+                        acc = dvr_run(r, g, kk, k_end, ratios[s], ray, acc, occupancy, stop, true);
+                    } else {
+                        set_lod(0.0);
+                        acc = dvr_run(r, g, kk, k_end, ratios[s], ray, acc, occupancy, stop, false);
                     }
+#else
+                    acc = dvr_run(r, g, kk, k_end, ratios[s], ray, acc, occupancy, stop, true);
+#endif
 #ifdef DVR_PAIRS
                 }
 #endif
@@ -483,7 +484,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
             if r.mode == MODE_TWO_LEVEL {
                 var o = opens[s];
                 var part = open_part(r, o);
-                if !skip || (r.flags & REGION_OCCUPANCY) == 0u || !at_full_resolution() || brick_occupied(r, q) {
+                if !skip || (r.flags & REGION_OCCUPANCY) == 0u || brick_occupied(r, q) {
                     acc = two_level_sample(r, regions[r.objects.z], &part, &o, q, ratios[s], ray, t, acc);
                 } else {
                     acc = end_segment(r, part, &o, acc);
@@ -525,7 +526,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
 #endif
             {
 #ifdef HAS_DVR
-                if !skip || (r.flags & REGION_OCCUPANCY) == 0u || !at_full_resolution() || brick_occupied(r, q) {
+                if !skip || (r.flags & REGION_OCCUPANCY) == 0u || brick_occupied(r, q) {
 #ifdef HAS_SELECTION
                     set_weight(region_weight(r));
 #endif
@@ -557,6 +558,29 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
     }
     if (settings.flags & VIEW_DEBUG_COUNTS) != 0u {
         return debug_counts();
+    }
+    return acc;
+}
+
+// The DVR samples kk … k_end of one region's segment g composited under acc, until
+// opacity `stop`; `occupancy`: empty bricks are crossed. `lensed` as
+// focal::segments::segment_point_at: a literal at each call, so each call compiles to
+// its own loop (with false, the mip level is the one set before it throughout).
+fn dvr_run(r: Region, g: Segment, kk_in: f32, k_end: f32, ratio: f32, ray: Ray, acc_in: vec4<f32>, occupancy: bool, stop: f32, lensed: bool) -> vec4<f32> {
+    var kk = kk_in;
+    var acc = acc_in;
+    for (var dvr_steps = 0u; dvr_steps < scene.max_steps; dvr_steps++) {
+        if kk > k_end || acc.a >= stop {
+            break;
+        }
+        if occupancy {
+            kk = past_empty_bricks_at(r, g, kk, k_end, lensed);
+            if kk > k_end {
+                break;
+            }
+        }
+        acc = dvr_sample(r, segment_point_at(g, kk, lensed), ratio, ray, segment_t(g, kk), acc);
+        kk += 1.0;
     }
     return acc;
 }

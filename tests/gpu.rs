@@ -369,7 +369,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 33] = [
+    let tests: [GpuTest; 34] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -384,6 +384,7 @@ fn main() {
         ("antialiasing_removes_moire_where_lenses_compress", lenses::antialiasing_removes_moire_where_lenses_compress),
         ("feature_lens_matches_the_reference", lenses::feature_lens_matches_the_reference),
         ("a_lens_that_compresses_nothing_takes_no_more_samples", lenses::a_lens_that_compresses_nothing_takes_no_more_samples),
+        ("antialiased_lenses_skip_empty_space_exactly", lenses::antialiased_lenses_skip_empty_space_exactly),
         (
             "a_reduced_resolution_is_the_picture_of_fewer_rays_upscaled",
             interactive::a_reduced_resolution_is_the_picture_of_fewer_rays_upscaled,

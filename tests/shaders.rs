@@ -121,6 +121,30 @@ fn every_shader_variant_composes_and_validates() {
     }
 }
 
+/// The lens kinds' and shapes' defs (mirrors `render::gpu_types::features::LENS_NAMES`).
+const LENS_DEFS: [&str; 5] = ["HAS_MAGNIFIER", "HAS_SAMPLING_LENS", "HAS_ANGULAR_LENS", "HAS_POLYGON_LENS", "HAS_FEATURE_LENS"];
+
+#[test]
+fn every_lens_kind_variant_composes_and_validates() {
+    let names: Vec<&str> = focal::render::gpu_types::features::LENS_NAMES.iter().map(|(_, n)| *n).collect();
+    assert_eq!(names, LENS_DEFS);
+    // Each set of kinds and shapes, under lenses with and without anti-aliasing, over
+    // memory and bricked data (they touch ray generation alone).
+    for bits in 0u32..(1 << LENS_DEFS.len()) {
+        for base in [&["HAS_DVR", "HAS_LENSES", "LENS_ANTIALIAS"][..], &["HAS_DVR", "HAS_LENSES", "HAS_BRICKED", "BRICKED_ONLY"]] {
+            let defs: HashMap<String, ShaderDefValue> = LENS_DEFS
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| bits & (1 << i) != 0)
+                .map(|(_, d)| *d)
+                .chain(base.iter().copied())
+                .map(|d| (d.to_string(), ShaderDefValue::Bool(true)))
+                .collect();
+            compose_and_validate("shaders/raycast.wgsl", defs);
+        }
+    }
+}
+
 #[test]
 fn the_feature_lens_compute_shader_composes_and_validates() {
     compose_and_validate("shaders/feature.wgsl", HashMap::new());

@@ -103,16 +103,24 @@ fn feature_distance(base: u32, s: vec2<f32>) -> f32 {
     return mix(top, bottom, fy) + beyond;
 }
 
+// (Each kind's and shape's code only where the view has such a lens, shader defs
+// HAS_MAGNIFIER, HAS_SAMPLING_LENS, HAS_ANGULAR_LENS, HAS_POLYGON_LENS, HAS_FEATURE_LENS
+// (render::pipeline::lens_kinds): llvmpipe runs all of it in every lane, for five rays
+// a pixel with anti-aliasing.)
 fn radial(lens: Lens, base: u32, v: vec2<f32>) -> f32 {
+#ifdef HAS_FEATURE_LENS
     if lens.codes.y == SHAPE_FEATURE {
         return lens.geometry.z + feature_distance(base, lens.geometry.xy + v);
     }
+#endif
     if lens.codes.y == SHAPE_SQUARE {
         return max(abs(v.x), abs(v.y));
     }
+#ifdef HAS_POLYGON_LENS
     if lens.codes.y == SHAPE_POLYGON {
         return lens.geometry.z + outline_distance(base, lens.codes.w, v);
     }
+#endif
     return length(v);
 }
 
@@ -202,6 +210,7 @@ fn lens_ray(uv: vec2<f32>) -> Ray {
         let base = i * LENS_DATA;
         // A feature lens is centred on its silhouette and sized by it; a feature out of
         // view leaves the rays alone.
+#ifdef HAS_FEATURE_LENS
         if lens.codes.y == SHAPE_FEATURE {
             let o = u32(settings.lens_data[base + 1u].z);
             if feature_fields[o + 3u] < 0.5 {
@@ -209,10 +218,13 @@ fn lens_ray(uv: vec2<f32>) -> Ray {
             }
             lens.geometry = vec4(feature_fields[o], feature_fields[o + 1u], feature_fields[o + 2u], lens.geometry.w);
         }
+#endif
         let centre = lens.geometry.xy;
         let lr = lens.geometry.z;
         let v = s - centre;
         let r = radial(lens, base, v);
+        // (One kind per lens: the `if`s exclude each other.)
+#ifdef HAS_MAGNIFIER
         if lens.codes.x == LENS_MAGNIFIER {
             var reach = lr + lens.geometry.w;
             if lens.codes.z == PROFILE_SIMPLE {
@@ -221,18 +233,25 @@ fn lens_ray(uv: vec2<f32>) -> Ray {
             if r < reach {
                 ray = bend(lens, camera_ray(lens_uv(centre)), ray, r);
             }
-        } else if lens.codes.x == LENS_SAMPLING {
+        }
+#endif
+#ifdef HAS_SAMPLING_LENS
+        if lens.codes.x == LENS_SAMPLING {
             if r < lr && r > 0.0 {
                 let rho = sampling_source(base, r / lr) * lr;
                 ray = camera_ray(lens_uv(centre + v * (rho / r)));
             }
-        } else {
+        }
+#endif
+#ifdef HAS_ANGULAR_LENS
+        if lens.codes.x == LENS_ANGULAR {
             if r < lr {
                 ray = fisheye(camera_ray(lens_uv(centre)), v, lr, lens.params.x);
             } else if lens.params.y > 0.5 {
                 return Ray(ray.origin, vec3(0.0));
             }
         }
+#endif
     }
     return ray;
 }
@@ -363,6 +382,11 @@ fn restrict_footprint(t0: f32, t1: f32) {
     if lod_at(t0) <= 0.0 && lod_at(t1) <= 0.0 {
         has_footprint = false;
     }
+}
+
+// After restrict_footprint: whether the ray's mip level may leave 0 along it.
+fn level_varies() -> bool {
+    return has_footprint;
 }
 
 // Sets the mip level of the samples at ray parameter t.

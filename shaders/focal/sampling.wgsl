@@ -70,11 +70,16 @@ fn trilinear_memory(r: Region, q: vec3<f32>) -> f32 {
     // the condition, and this code made every sample under a lens three times as
     // expensive without anti-aliasing. With it, two fetches per sample, the levels on
     // either side of the sample's, at full resolution the volume twice.)
+    // (The second level under a branch of its own: where the level is a constant 0,
+    // rays that compress nothing, the compiler drops it and the level's selects.)
     let l = clamp(sample_lod, 0.0, f32(r.mip_count));
     let k = u32(floor(l));
-    let a = level_sample(r, q, k);
-    let b = level_sample(r, q, min(k + 1u, r.mip_count));
-    return mix(a, b, l - f32(k));
+    var v = level_sample(r, q, k);
+    let f = l - f32(k);
+    if f > 0.0 {
+        v = mix(v, level_sample(r, q, min(k + 1u, r.mip_count)), f);
+    }
+    return v;
 #else
     return trilinear_box(r.atlas_offset.xyz, r.dims.xyz, q);
 #endif
@@ -236,6 +241,8 @@ fn brick_of(r: Region, q: vec3<f32>) -> vec3<u32> {
     return min(vec3<u32>(b), r.bricks.xyz - 1u);
 }
 
+// Whether q's brick holds anything visible (a bricked region's: its sub-block), for
+// samples of the current mip level.
 fn brick_occupied(r: Region, q: vec3<f32>) -> bool {
 #ifdef HAS_BRICKED
     if is_bricked(r) {
@@ -256,9 +263,12 @@ fn brick_occupied(r: Region, q: vec3<f32>) -> bool {
 #ifdef BRICKED_ONLY
     return false;
 #else
+    // (A sample from the mip chain blends in neighbouring bricks: the second set of
+    // bits, render::pack, Appearance::mip_brick_occupancy.)
     let b = brick_of(r, q);
     let i = (b.z * r.bricks.y + b.y) * r.bricks.x + b.x;
-    let word = occupancy[r.occupancy_offset + i / 32u];
+    let count = r.bricks.x * r.bricks.y * r.bricks.z;
+    let word = occupancy[r.occupancy_offset + select(0u, (count + 31u) / 32u, !at_full_resolution()) + i / 32u];
     return ((word >> (i % 32u)) & 1u) != 0u;
 #endif
 }

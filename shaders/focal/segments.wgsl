@@ -7,7 +7,7 @@
 #import focal::types::{Region, MAX_RAY_REGIONS}
 #import focal::bindings::{scene, regions}
 #import focal::lens::update_lod
-#import focal::sampling::{brick_occupied, brick_exit, at_full_resolution}
+#import focal::sampling::{brick_occupied, brick_exit}
 
 // Per-interval state bits: the region is done with; it has a previous sample (iso);
 // it is DVR-like (two such share the DVR loop); it composites at its end (projections,
@@ -35,8 +35,18 @@ fn segment_t(g: Segment, kk: f32) -> f32 {
 
 // Voxel position of sample kk; under lenses also sets the mip level for it.
 fn segment_point(g: Segment, kk: f32) -> vec3<f32> {
+    return segment_point_at(g, kk, true);
+}
+
+// segment_point where `lensed` says whether the ray's mip level may change along it
+// (a literal at each call site: with false the inlined code keeps the level it is
+// given and the compiler folds the mip chain's blend away, focal::raycast's
+// plain_segment).
+fn segment_point_at(g: Segment, kk: f32, lensed: bool) -> vec3<f32> {
 #ifdef HAS_LENSES
-    update_lod(segment_t(g, kk));
+    if lensed {
+        update_lod(segment_t(g, kk));
+    }
 #endif
     return g.q_first + g.dq * (kk - g.k_first);
 }
@@ -46,19 +56,24 @@ fn past_brick(r: Region, g: Segment, q: vec3<f32>, kk: f32) -> f32 {
     return max(kk + 1.0, ceil((brick_exit(r, q, g.qd, segment_t(g, kk)) - g.t_start) / g.step - g.j));
 }
 
-// The first sample from kk on (at most k_end + 1) that lies in an occupied brick or
-// below full resolution: empty bricks are crossed in a loop of their own, so the lanes
-// of a SIMD group that skip wait for each other there, then all take the next
-// (expensive) sample together. Occupancy holds for full-resolution samples only (a
-// coarser level blends in neighbouring bricks).
+// The first sample from kk on (at most k_end + 1) that lies in an occupied brick (for
+// a sample of the mip chain, under lenses with anti-aliasing, one whose neighbourhood
+// may be visible: sampling::brick_occupied): empty bricks are crossed in a loop of
+// their own, so the lanes of a SIMD group that skip wait for each other there, then
+// all take the next (expensive) sample together.
 fn past_empty_bricks(r: Region, g: Segment, kk_in: f32, k_end: f32) -> f32 {
+    return past_empty_bricks_at(r, g, kk_in, k_end, true);
+}
+
+// past_empty_bricks with segment_point_at's `lensed`.
+fn past_empty_bricks_at(r: Region, g: Segment, kk_in: f32, k_end: f32, lensed: bool) -> f32 {
     var kk = kk_in;
     for (var skip_steps = 0u; skip_steps < scene.max_steps; skip_steps++) {
         if kk > k_end {
             break;
         }
-        let q = segment_point(g, kk);
-        if !at_full_resolution() || brick_occupied(r, q) {
+        let q = segment_point_at(g, kk, lensed);
+        if brick_occupied(r, q) {
             break;
         }
         kk = past_brick(r, g, q, kk);
@@ -67,7 +82,7 @@ fn past_empty_bricks(r: Region, g: Segment, kk_in: f32, k_end: f32) -> f32 {
 }
 
 // [`past_empty_bricks`] for two regions sampled together: the first sample from kk on
-// where either lies in an occupied brick (or below full resolution).
+// where either lies in an occupied brick.
 fn past_empty_pair(ra: Region, ga: Segment, rb: Region, gb: Segment, kk_in: f32, k_end: f32) -> f32 {
     var kk = kk_in;
     for (var skip_steps = 0u; skip_steps < scene.max_steps; skip_steps++) {
@@ -76,7 +91,7 @@ fn past_empty_pair(ra: Region, ga: Segment, rb: Region, gb: Segment, kk_in: f32,
         }
         let qa = segment_point(ga, kk);
         let qb = gb.q_first + gb.dq * (kk - gb.k_first);
-        if !at_full_resolution() || brick_occupied(ra, qa) || brick_occupied(rb, qb) {
+        if brick_occupied(ra, qa) || brick_occupied(rb, qb) {
             break;
         }
         kk = min(past_brick(ra, ga, qa, kk), past_brick(rb, gb, qb, kk));

@@ -69,6 +69,9 @@ pub struct PreparedRegion<'a> {
     /// Per-brick visibility (DVR modes with a transfer function): invisible bricks add
     /// nothing and are not sampled.
     pub occupancy: Option<(&'a BrickGrid, Vec<bool>)>,
+    /// Per-brick visibility of samples from the mip levels (lenses' anti-aliasing,
+    /// `Appearance::mip_brick_occupancy`); `None`: every brick may be visible there.
+    pub mip_occupancy: Option<Vec<bool>>,
     /// κt, κs of [`Mode::Context`].
     pub context: ContextParams,
     /// World-space bounding sphere (centre, radius) of the volume's box: the extent the
@@ -205,6 +208,7 @@ impl<'a> PreparedRegion<'a> {
         // DVR at κt = 0 is DVR.
         let mode = if labels { Mode::Dvr } else { appearance.effective_mode() };
         let occupancy = appearance.brick_occupancy(volume).map(|occ| (volume.bricks(), occ));
+        let mip_occupancy = occupancy.as_ref().and_then(|_| appearance.mip_brick_occupancy(volume));
         let a = Mat3::from(region.world_to_voxel.matrix3);
         let index_to_native = volume.grid.direction * Mat3::from_diagonal(volume.grid.spacing);
         let reference_length = volume.opacity_reference();
@@ -224,6 +228,7 @@ impl<'a> PreparedRegion<'a> {
             projection_group: usize::MAX,
             gradient_max: volume.gradient_max().max(1e-6),
             occupancy,
+            mip_occupancy,
             context: appearance.context,
             sphere: bounding_sphere(region, volume),
             objects: None,

@@ -268,6 +268,24 @@ impl Appearance {
         }
     }
 
+    /// [`Self::brick_occupancy`] for samples of the volume's mip levels (lenses'
+    /// anti-aliasing, which blends a brick's neighbours in): a brick's whole
+    /// neighbourhood range must be invisible (`BrickGrid::neighbourhood_occupancy`);
+    /// label volumes are never blended (their occupancy holds). A selection only takes
+    /// opacity away, so the look's own answer bounds it; `None` where that does not
+    /// hold (segmented volumes: each object has its own look) and where
+    /// [`Self::brick_occupancy`] is `None`: every brick is then sampled at those levels.
+    pub fn mip_brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {
+        if self.segmentation.is_some() {
+            return None;
+        }
+        let visible = self.own_code_visibility(volume)?;
+        match self.lookup {
+            Lookup::Labels(_) => Some(volume.bricks().occupancy(visible)),
+            Lookup::Transfer(_) => volume.bricks().neighbourhood_occupancy(visible),
+        }
+    }
+
     /// [`Self::brick_occupancy`] of this appearance's own mode and lookup (for a
     /// segmented volume: of the rest).
     fn own_brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {

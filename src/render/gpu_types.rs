@@ -93,6 +93,24 @@ pub mod features {
     /// boundaries (`region_flags::ON_GRID`).
     pub const OWN_VALUES: u32 = 262144;
 
+    /// The view's lenses, by kind and shape (per-view features, with [`LENSES`]): the
+    /// code of the others is left out (llvmpipe ran every kind's and shape's code for
+    /// every ray of a lens, five rays a pixel with anti-aliasing's footprint).
+    pub const LENS_MAGNIFIER: u32 = 1 << 19;
+    pub const LENS_SAMPLING: u32 = 1 << 20;
+    pub const LENS_ANGULAR: u32 = 1 << 21;
+    pub const LENS_POLYGON: u32 = 1 << 22;
+    pub const LENS_FEATURE: u32 = 1 << 23;
+
+    /// Shader def names of the lens kinds and shapes, by bit.
+    pub const LENS_NAMES: [(u32, &str); 5] = [
+        (LENS_MAGNIFIER, "HAS_MAGNIFIER"),
+        (LENS_SAMPLING, "HAS_SAMPLING_LENS"),
+        (LENS_ANGULAR, "HAS_ANGULAR_LENS"),
+        (LENS_POLYGON, "HAS_POLYGON_LENS"),
+        (LENS_FEATURE, "HAS_FEATURE_LENS"),
+    ];
+
     /// Shader def names, by bit.
     pub const NAMES: [(u32, &str); 19] = [
         (DVR, "HAS_DVR"),

@@ -228,11 +228,7 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
         let grid = labels.bricks();
         let boundary = crate::twolevel::boundary_bricks(grid);
         bricks = grid.dims.extend(grid.size);
-        let mut words = vec![0u32; boundary.len().div_ceil(32)];
-        for (i, _) in boundary.iter().enumerate().filter(|(_, b)| **b) {
-            words[i / 32] |= 1 << (i % 32);
-        }
-        out.occupancy.extend(words);
+        out.occupancy.extend(occupancy_words(boundary.iter().copied()));
         flags = region_flags::OCCUPANCY;
     }
     out.regions.push(GpuRegion {
@@ -248,6 +244,17 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
         ..Default::default()
     });
     UVec4::new(first, objects.parts.len() as u32, out.regions.len() as u32 - 1, 0)
+}
+
+/// One bit per brick, 32 a word.
+fn occupancy_words(bits: impl ExactSizeIterator<Item = bool>) -> Vec<u32> {
+    let mut words = vec![0u32; bits.len().div_ceil(32)];
+    for (i, o) in bits.enumerate() {
+        if o {
+            words[i / 32] |= 1 << (i % 32);
+        }
+    }
+    words
 }
 
 /// Most iterations any loop of the ray caster can make on one ray through `regions`:
@@ -421,13 +428,14 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
     let bricks = grid.dims.extend(grid.size);
     if let Some((_, occ)) = &p.occupancy {
         flags |= region_flags::OCCUPANCY;
-        let mut words = vec![0u32; occ.len().div_ceil(32)];
-        for (i, &o) in occ.iter().enumerate() {
-            if o {
-                words[i / 32] |= 1 << (i % 32);
-            }
+        // The bits of full-resolution samples, then those of mip samples (every brick
+        // where they are unknown; sampling.wgsl brick_occupied).
+        let mips = p.mip_occupancy.as_ref().filter(|m| m.len() == occ.len());
+        out.occupancy.extend(occupancy_words(occ.iter().copied()));
+        match mips {
+            Some(m) => out.occupancy.extend(occupancy_words(m.iter().copied())),
+            None => out.occupancy.extend(occupancy_words(occ.iter().map(|_| true))),
         }
-        out.occupancy.extend(words);
     }
     let s = &p.shading;
     GpuRegion {

@@ -10,7 +10,7 @@ use bevy::render::renderer::RenderDevice;
 use bevy::render::view::{ExtractedView, ViewTarget, ViewUniform};
 use bevy::shader::Shader;
 
-use super::gpu_types::{GpuSceneInfo, GpuSettings, features};
+use super::gpu_types::{GpuLens, GpuSceneInfo, GpuSettings, features, lens_codes};
 
 /// Pipeline state shared by every view.
 #[derive(Resource)]
@@ -74,7 +74,12 @@ impl SpecializedRenderPipeline for RaycastPipeline {
             vertex: self.fullscreen.to_vertex_state(),
             fragment: Some(FragmentState {
                 shader: self.shader.clone(),
-                shader_defs: features::NAMES.iter().filter(|(bit, _)| key.features & bit != 0).map(|(_, name)| (*name).into()).collect(),
+                shader_defs: features::NAMES
+                    .iter()
+                    .chain(&features::LENS_NAMES)
+                    .filter(|(bit, _)| key.features & bit != 0)
+                    .map(|(_, name)| (*name).into())
+                    .collect(),
                 targets: vec![Some(ColorTargetState {
                     format: key.format,
                     // Premultiplied "over" onto the meshes already drawn.
@@ -98,12 +103,32 @@ pub struct RaycastPipelineId(pub CachedRenderPipelineId);
 /// alone reads none, its rays take their level from their footprint instead, and the
 /// lens footprint per pixel cost the bench's 4× magnifier ×2.9 → ×1.9 for nothing,
 /// besides switching empty-space skipping off in the lens border).
-pub fn lens_features(features: u32, lenses: bool, antialias: bool) -> u32 {
-    match (lenses, antialias) {
-        (false, _) => 0,
-        (true, true) if features & features::BRICKED_ONLY == 0 => features::LENSES | features::LENS_ANTIALIAS,
-        (true, _) => features::LENSES,
+/// With them, the kinds and shapes of `lenses` ([`lens_kinds`]).
+pub fn lens_features(features: u32, lenses: &[GpuLens], antialias: bool) -> u32 {
+    let kinds = lens_kinds(lenses);
+    match (lenses.is_empty(), antialias) {
+        (true, _) => 0,
+        (false, true) if features & features::BRICKED_ONLY == 0 => features::LENSES | features::LENS_ANTIALIAS | kinds,
+        (false, _) => features::LENSES | kinds,
     }
+}
+
+/// The lens kinds and shapes among `lenses` (features::LENS_NAMES; circles and squares
+/// are two lines of code and always there).
+pub fn lens_kinds(lenses: &[GpuLens]) -> u32 {
+    lenses.iter().fold(0, |bits, lens| {
+        let kind = match lens.codes.x {
+            lens_codes::SAMPLING => features::LENS_SAMPLING,
+            lens_codes::ANGULAR => features::LENS_ANGULAR,
+            _ => features::LENS_MAGNIFIER,
+        };
+        let shape = match lens.codes.y {
+            lens_codes::POLYGON => features::LENS_POLYGON,
+            lens_codes::FEATURE => features::LENS_FEATURE,
+            _ => 0,
+        };
+        bits | kind | shape
+    })
 }
 
 pub fn prepare_pipelines(
@@ -117,7 +142,8 @@ pub fn prepare_pipelines(
 ) {
     let features = super::bricked::mark::pipeline_features(scene.features, atlas.coarse_in_atlas);
     for (entity, target, settings) in &views {
-        let lenses = lens_features(features, settings.lens_count > 0, settings.flags & super::gpu_types::view_flags::LENS_ANTIALIAS != 0);
+        let count = (settings.lens_count as usize).min(settings.lenses.len());
+        let lenses = lens_features(features, &settings.lenses[..count], settings.flags & super::gpu_types::view_flags::LENS_ANTIALIAS != 0);
         let key = RaycastKey { format: target.main_texture_format(), features: features | lenses };
         let id = pipelines.specialize(&cache, &pipeline, key);
         commands.entity(entity).insert(RaycastPipelineId(id));
@@ -130,10 +156,22 @@ mod tests {
 
     #[test]
     fn lens_antialiasing_only_where_a_region_is_in_memory() {
-        let (l, aa) = (features::LENSES, features::LENS_ANTIALIAS);
-        assert_eq!(lens_features(features::DVR, false, true), 0);
-        assert_eq!(lens_features(features::DVR, true, false), l);
-        assert_eq!(lens_features(features::DVR | features::BRICKED, true, true), l | aa);
-        assert_eq!(lens_features(features::DVR | features::BRICKED | features::BRICKED_ONLY, true, true), l);
+        let (l, aa, m) = (features::LENSES, features::LENS_ANTIALIAS, features::LENS_MAGNIFIER);
+        let one = [GpuLens::default()];
+        assert_eq!(lens_features(features::DVR, &[], true), 0);
+        assert_eq!(lens_features(features::DVR, &one, false), l | m);
+        assert_eq!(lens_features(features::DVR | features::BRICKED, &one, true), l | aa | m);
+        assert_eq!(lens_features(features::DVR | features::BRICKED | features::BRICKED_ONLY, &one, true), l | m);
+    }
+
+    #[test]
+    fn only_the_lenses_kinds_and_shapes_are_compiled() {
+        let lens = |kind, shape| GpuLens { codes: UVec4::new(kind, shape, 0, 0), ..Default::default() };
+        assert_eq!(lens_kinds(&[]), 0);
+        assert_eq!(lens_kinds(&[lens(lens_codes::MAGNIFIER, lens_codes::SQUARE)]), features::LENS_MAGNIFIER);
+        assert_eq!(
+            lens_kinds(&[lens(lens_codes::SAMPLING, lens_codes::FEATURE), lens(lens_codes::ANGULAR, lens_codes::POLYGON)]),
+            features::LENS_SAMPLING | features::LENS_ANGULAR | features::LENS_FEATURE | features::LENS_POLYGON
+        );
     }
 }

@@ -92,7 +92,48 @@ impl BrickGrid {
     pub fn occupancy(&self, visible: impl Fn(u16, u16) -> bool) -> Vec<bool> {
         self.min.iter().zip(&self.max).map(|(&lo, &hi)| visible(lo, hi)).collect()
     }
+
+    /// The code range of brick `b` and its (up to 26) neighbours: it holds every
+    /// trilinear sample of mip levels 1 to [`NEIGHBOURHOOD_LEVELS`] at a position inside
+    /// `b` (`volume::pyramid`: a level-k voxel averages 2^k voxels per axis, its taps at
+    /// a position in `b` reach at most one brick of 8 voxels beyond it), `None` for
+    /// bricks smaller than that.
+    pub fn neighbourhood_range(&self, b: UVec3) -> Option<(u16, u16)> {
+        if self.size < 1 << NEIGHBOURHOOD_LEVELS {
+            return None;
+        }
+        let lo = b.saturating_sub(UVec3::ONE);
+        let hi = (b + 1).min(self.dims - 1);
+        let (mut mn, mut mx) = (u16::MAX, 0u16);
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let (a, c) = self.range(UVec3::new(x, y, z));
+                    mn = mn.min(a);
+                    mx = mx.max(c);
+                }
+            }
+        }
+        Some((mn, mx))
+    }
+
+    /// [`Self::occupancy`] of samples from mip levels 1 to [`NEIGHBOURHOOD_LEVELS`]
+    /// (lenses' anti-aliasing): a brick is worth visiting where its
+    /// [`Self::neighbourhood_range`] can be visible; `None` for bricks too small.
+    pub fn neighbourhood_occupancy(&self, visible: impl Fn(u16, u16) -> bool) -> Option<Vec<bool>> {
+        (0..self.len())
+            .map(|i| {
+                let (x, y) = (i as u32 % self.dims.x, i as u32 / self.dims.x % self.dims.y);
+                let z = i as u32 / (self.dims.x * self.dims.y);
+                self.neighbourhood_range(UVec3::new(x, y, z)).map(|(lo, hi)| visible(lo, hi))
+            })
+            .collect()
+    }
 }
+
+/// Mip levels whose samples [`BrickGrid::neighbourhood_range`] bounds (those the
+/// lenses' anti-aliasing reads, `volume::pyramid::MIP_LEVELS`).
+pub const NEIGHBOURHOOD_LEVELS: u32 = 3;
 
 impl BrickGrid {
     /// Continuous voxel-index box `(lo, hi)` enclosing the bricks where `keep` is true.
@@ -145,6 +186,55 @@ mod tests {
         // Brick 0 samples up to x = 7.5, which interpolates voxel 8: it must see 200.
         assert_eq!(g.range(UVec3::new(0, 0, 0)), (0, 200));
         assert_eq!(g.range(UVec3::new(1, 0, 0)), (0, 200));
+    }
+
+    #[test]
+    fn mip_samples_lie_in_their_bricks_neighbourhood_range() {
+        // Every trilinear sample of levels 1–3 (and the blends between them) at a
+        // position inside a brick lies in that brick's neighbourhood range: checked on
+        // the pyramid's own samples at random positions of volumes whose sides are no
+        // multiple of the brick.
+        use crate::volume::pyramid::{self, level_index};
+        use crate::volume::sample::VolumeSampler;
+        assert_eq!(pyramid::MIP_LEVELS as u32, NEIGHBOURHOOD_LEVELS);
+        let dims = UVec3::new(29, 21, 19);
+        let mut seed = 12345u64;
+        let mut next = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 33) as u32
+        };
+        let at = |i: u32| (i % dims.x, i / dims.x % dims.y, i / (dims.x * dims.y));
+        // Random constant cells of 3³ voxels; and a bright slab at x ≥ 17, which brick
+        // 1's own range (voxels 7…16) does not see but its level-3 samples do.
+        let cells: Vec<u16> = (0..10 * 7 * 7).map(|_| (next() % 60000) as u16).collect();
+        let cell = |i: u32| {
+            let (x, y, z) = at(i);
+            cells[(((z / 3) * 7 + y / 3) * 10 + x / 3) as usize]
+        };
+        let slab = |i: u32| if at(i).0 >= 17 { 60000 } else { 0 };
+        let mut outside_own = 0;
+        for field in [&cell as &dyn Fn(u32) -> u16, &slab] {
+            let voxels = Voxels::U16((0..dims.x * dims.y * dims.z).map(field).collect());
+            let g = BrickGrid::build(&voxels, dims, 8);
+            let levels = pyramid::build(&voxels, dims);
+            for _ in 0..20000 {
+                let q = Vec3::new(next() as f32, next() as f32, next() as f32) / (1u64 << 31) as f32;
+                let q = q * dims.as_vec3() - 0.5;
+                let b = g.brick_at(q);
+                let Some((lo, hi)) = g.neighbourhood_range(b) else { panic!("bricks of 8 have a neighbourhood range") };
+                for (k, level) in levels.iter().enumerate() {
+                    let v = VolumeSampler::new(&level.voxels, level.dims).trilinear(level_index(q, k as u32 + 1)) * 65535.0;
+                    assert!(v >= lo as f32 - 0.01 && v <= hi as f32 + 0.01, "level {} at {q}: {v} outside {lo}…{hi}", k + 1);
+                    let (a, c) = g.range(b);
+                    outside_own += usize::from(v < a as f32 - 0.01 || v > c as f32 + 0.01);
+                }
+            }
+            assert_eq!(BrickGrid::build(&voxels, dims, 4).neighbourhood_range(UVec3::ZERO), None);
+            let occupied = g.neighbourhood_occupancy(|lo, hi| lo < 100 && hi > 59000);
+            assert_eq!(occupied.map(|o| o.len()), Some(g.len()));
+        }
+        // (The brick's own range would not do: coarser samples reach its neighbours.)
+        assert!(outside_own > 0);
     }
 
     #[test]
