@@ -44,6 +44,30 @@ fn value_at(r: Region, q: vec3<f32>, vd: vec2<f32>) -> f32 {
 // t, composited under acc, weighted by the current selection weight. The gradient is
 // fetched once for shading and modulation.
 fn dvr_sample(r: Region, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
+    let c = dvr_classify(r, q);
+    return dvr_classified(r, q, c.v, c.rgba, c.weight, ratio, ray, t, acc);
+}
+
+// A DVR sample classified: its value (0 for labels), colour and opacity, and the
+// selection's weight of that opacity.
+struct Classified {
+    v: f32,
+    rgba: vec4<f32>,
+    weight: f32,
+}
+
+// Whether a classified sample can add anything to the ray (with a companion look, any
+// sample may).
+fn adds_something(c: Classified) -> bool {
+#ifdef COMPANION
+    return true;
+#else
+    return c.rgba.a * c.weight > 0.0;
+#endif
+}
+
+// The first half of dvr_sample: the sample at q classified.
+fn dvr_classify(r: Region, q: vec3<f32>) -> Classified {
     count_sample();
     var rgba: vec4<f32>;
     var v = 0.0;
@@ -67,7 +91,7 @@ fn dvr_sample(r: Region, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f
 #ifdef HAS_SELECTION
     w = weight_at(q, vd.y);
 #endif
-    return dvr_classified(r, q, v, rgba, w, ratio, ray, t, acc);
+    return Classified(v, rgba, w);
 }
 
 // dvr_sample after classification: value v (0 for labels) gave rgba, whose opacity
