@@ -263,12 +263,13 @@ fn brick_occupied(r: Region, q: vec3<f32>) -> bool {
 #ifdef BRICKED_ONLY
     return false;
 #else
-    // (A sample from the mip chain blends in neighbouring bricks: the second set of
-    // bits, render::pack, Appearance::mip_brick_occupancy.)
+    // (A sample from the mip chain blends in neighbouring voxels: the second set of
+    // bits up to level 1, the third beyond, render::pack, Appearance::mip_brick_occupancy.)
     let b = brick_of(r, q);
     let i = (b.z * r.bricks.y + b.y) * r.bricks.x + b.x;
-    let count = r.bricks.x * r.bricks.y * r.bricks.z;
-    let word = occupancy[r.occupancy_offset + select(0u, (count + 31u) / 32u, !at_full_resolution()) + i / 32u];
+    let words = (r.bricks.x * r.bricks.y * r.bricks.z + 31u) / 32u;
+    let bits = select(0u, 1u, sample_lod > 0.0) + select(0u, 1u, sample_lod > 1.0);
+    let word = occupancy[r.occupancy_offset + bits * words + i / 32u];
     return ((word >> (i % 32u)) & 1u) != 0u;
 #endif
 }

@@ -69,9 +69,10 @@ pub struct PreparedRegion<'a> {
     /// Per-brick visibility (DVR modes with a transfer function): invisible bricks add
     /// nothing and are not sampled.
     pub occupancy: Option<(&'a BrickGrid, Vec<bool>)>,
-    /// Per-brick visibility of samples from the mip levels (lenses' anti-aliasing,
-    /// `Appearance::mip_brick_occupancy`); `None`: every brick may be visible there.
-    pub mip_occupancy: Option<Vec<bool>>,
+    /// Per-brick visibility of samples from mip levels up to 1, and from coarser ones
+    /// (lenses' anti-aliasing, `Appearance::mip_brick_occupancy`); `None`: every brick
+    /// may be visible there.
+    pub mip_occupancy: Option<[Vec<bool>; 2]>,
     /// κt, κs of [`Mode::Context`].
     pub context: ContextParams,
     /// World-space bounding sphere (centre, radius) of the volume's box: the extent the

@@ -269,20 +269,28 @@ impl Appearance {
     }
 
     /// [`Self::brick_occupancy`] for samples of the volume's mip levels (lenses'
-    /// anti-aliasing, which blends a brick's neighbours in): a brick's whole
-    /// neighbourhood range must be invisible (`BrickGrid::neighbourhood_occupancy`);
-    /// label volumes are never blended (their occupancy holds). A selection only takes
-    /// opacity away, so the look's own answer bounds it; `None` where that does not
-    /// hold (segmented volumes: each object has its own look) and where
-    /// [`Self::brick_occupancy`] is `None`: every brick is then sampled at those levels.
-    pub fn mip_brick_occupancy(&self, volume: &Volume) -> Option<Vec<bool>> {
+    /// anti-aliasing, which blends neighbouring voxels in): for levels up to 1 (and
+    /// blends of 0 and 1) a brick's range over a wider apron must be invisible
+    /// (`Volume::level_one_bricks`), for coarser ones its whole neighbourhood's
+    /// (`BrickGrid::neighbourhood_occupancy`); label volumes are never blended (their
+    /// occupancy holds for both). A selection only takes opacity away, so the look's own
+    /// answer bounds it; `None` where that does not hold (segmented volumes: each object
+    /// has its own look) and where [`Self::brick_occupancy`] is `None`: every brick is
+    /// then sampled at those levels.
+    pub fn mip_brick_occupancy(&self, volume: &Volume) -> Option<[Vec<bool>; 2]> {
         if self.segmentation.is_some() {
             return None;
         }
         let visible = self.own_code_visibility(volume)?;
         match self.lookup {
-            Lookup::Labels(_) => Some(volume.bricks().occupancy(visible)),
-            Lookup::Transfer(_) => volume.bricks().neighbourhood_occupancy(visible),
+            Lookup::Labels(_) => {
+                let fine = volume.bricks().occupancy(visible);
+                Some([fine.clone(), fine])
+            }
+            Lookup::Transfer(_) => {
+                let coarse = volume.bricks().neighbourhood_occupancy(&visible)?;
+                Some([volume.level_one_bricks().occupancy(visible), coarse])
+            }
         }
     }
 

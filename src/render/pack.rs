@@ -428,13 +428,15 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
     let bricks = grid.dims.extend(grid.size);
     if let Some((_, occ)) = &p.occupancy {
         flags |= region_flags::OCCUPANCY;
-        // The bits of full-resolution samples, then those of mip samples (every brick
-        // where they are unknown; sampling.wgsl brick_occupied).
-        let mips = p.mip_occupancy.as_ref().filter(|m| m.len() == occ.len());
+        // The bits of full-resolution samples, then those of mip samples up to level 1
+        // and of coarser ones (every brick where they are unknown; sampling.wgsl
+        // brick_occupied).
         out.occupancy.extend(occupancy_words(occ.iter().copied()));
-        match mips {
-            Some(m) => out.occupancy.extend(occupancy_words(m.iter().copied())),
-            None => out.occupancy.extend(occupancy_words(occ.iter().map(|_| true))),
+        for k in 0..2 {
+            match p.mip_occupancy.as_ref().map(|m| &m[k]).filter(|m| m.len() == occ.len()) {
+                Some(m) => out.occupancy.extend(occupancy_words(m.iter().copied())),
+                None => out.occupancy.extend(occupancy_words(occ.iter().map(|_| true))),
+            }
         }
     }
     let s = &p.shading;

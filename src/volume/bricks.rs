@@ -32,6 +32,13 @@ pub struct BrickGrid {
 impl BrickGrid {
     /// Builds the grid for voxels of dimensions `dims`.
     pub fn build(voxels: &Voxels, dims: UVec3, size: u32) -> BrickGrid {
+        Self::build_with_apron(voxels, dims, size, 1)
+    }
+
+    /// [`Self::build`] with ranges over `apron` voxels beyond each brick on every side
+    /// (one holds its trilinear samples; two the samples of mip level 1 and of the
+    /// blends between levels 0 and 1, [`LEVEL_ONE_APRON`]).
+    pub fn build_with_apron(voxels: &Voxels, dims: UVec3, size: u32, apron: u32) -> BrickGrid {
         let size = size.max(1);
         let bdims = (dims + size - 1) / size;
         let count = bdims.x as usize * bdims.y as usize * bdims.z as usize;
@@ -41,8 +48,8 @@ impl BrickGrid {
                 let bx = (b % bdims.x as usize) as u32;
                 let by = (b / bdims.x as usize % bdims.y as usize) as u32;
                 let bz = (b / (bdims.x as usize * bdims.y as usize)) as u32;
-                let lo = (UVec3::new(bx, by, bz) * size).saturating_sub(UVec3::ONE);
-                let hi = ((UVec3::new(bx, by, bz) + 1) * size).min(dims - 1);
+                let lo = (UVec3::new(bx, by, bz) * size).saturating_sub(UVec3::splat(apron));
+                let hi = ((UVec3::new(bx, by, bz) + 1) * size + apron - 1).min(dims - 1);
                 match voxels {
                     Voxels::U8(v) => range_of(v, dims, lo, hi),
                     Voxels::U16(v) => range_of(v, dims, lo, hi),
@@ -135,6 +142,11 @@ impl BrickGrid {
 /// lenses' anti-aliasing reads, `volume::pyramid::MIP_LEVELS`).
 pub const NEIGHBOURHOOD_LEVELS: u32 = 3;
 
+/// The apron whose ranges hold the samples of mip level 1 at positions inside a brick
+/// (its trilinear taps at a position in brick b read level-1 voxels 4b − 1 … 4b + 4 of
+/// bricks of 8, level-0 voxels 8b − 2 … 8b + 9), and of the blends of levels 0 and 1.
+pub const LEVEL_ONE_APRON: u32 = 2;
+
 impl BrickGrid {
     /// Continuous voxel-index box `(lo, hi)` enclosing the bricks where `keep` is true.
     pub fn bounds_where(&self, keep: &[bool]) -> Option<(Vec3, Vec3)> {
@@ -216,12 +228,22 @@ mod tests {
         for field in [&cell as &dyn Fn(u32) -> u16, &slab] {
             let voxels = Voxels::U16((0..dims.x * dims.y * dims.z).map(field).collect());
             let g = BrickGrid::build(&voxels, dims, 8);
+            let near = BrickGrid::build_with_apron(&voxels, dims, 8, LEVEL_ONE_APRON);
             let levels = pyramid::build(&voxels, dims);
+            let level_zero = VolumeSampler::new(&voxels, dims);
             for _ in 0..20000 {
                 let q = Vec3::new(next() as f32, next() as f32, next() as f32) / (1u64 << 31) as f32;
                 let q = q * dims.as_vec3() - 0.5;
                 let b = g.brick_at(q);
                 let Some((lo, hi)) = g.neighbourhood_range(b) else { panic!("bricks of 8 have a neighbourhood range") };
+                // Level 1 and every blend of levels 0 and 1 within the apron-2 range.
+                let one = VolumeSampler::new(&levels[0].voxels, levels[0].dims).trilinear(level_index(q, 1)) * 65535.0;
+                let zero = level_zero.trilinear(q) * 65535.0;
+                let (a2, c2) = near.range(b);
+                for f in [0.0, 0.3, 1.0] {
+                    let v = zero + (one - zero) * f;
+                    assert!(v >= a2 as f32 - 0.01 && v <= c2 as f32 + 0.01, "level {f} at {q}: {v} outside {a2}…{c2}");
+                }
                 for (k, level) in levels.iter().enumerate() {
                     let v = VolumeSampler::new(&level.voxels, level.dims).trilinear(level_index(q, k as u32 + 1)) * 65535.0;
                     assert!(v >= lo as f32 - 0.01 && v <= hi as f32 + 0.01, "level {} at {q}: {v} outside {lo}…{hi}", k + 1);

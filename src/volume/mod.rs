@@ -60,6 +60,7 @@ pub struct Volume {
     /// smallest voxel spacing ([`Volume::opacity_reference`]).
     opacity_reference: Option<f32>,
     bricks: OnceLock<BrickGrid>,
+    level_one_bricks: OnceLock<BrickGrid>,
     gradient_max: OnceLock<f32>,
     pyramid: OnceLock<Vec<pyramid::Level>>,
 }
@@ -75,6 +76,7 @@ impl Clone for Volume {
             source: self.source.clone(),
             opacity_reference: self.opacity_reference,
             bricks: self.bricks.clone(),
+            level_one_bricks: self.level_one_bricks.clone(),
             gradient_max: self.gradient_max.clone(),
             pyramid: self.pyramid.clone(),
         }
@@ -106,6 +108,7 @@ impl Volume {
             source,
             opacity_reference: None,
             bricks: OnceLock::new(),
+            level_one_bricks: OnceLock::new(),
             gradient_max: OnceLock::new(),
             pyramid: OnceLock::new(),
         })
@@ -161,6 +164,13 @@ impl Volume {
     /// The brick min-max grid (built on first use, [`DEFAULT_BRICK_SIZE`]).
     pub fn bricks(&self) -> &BrickGrid {
         self.bricks.get_or_init(|| BrickGrid::build(&self.voxels, self.grid.dims, DEFAULT_BRICK_SIZE))
+    }
+
+    /// [`Self::bricks`] with ranges that hold the samples of mip level 1 too
+    /// ([`bricks::LEVEL_ONE_APRON`]; built on first use).
+    pub fn level_one_bricks(&self) -> &BrickGrid {
+        self.level_one_bricks
+            .get_or_init(|| BrickGrid::build_with_apron(&self.voxels, self.grid.dims, DEFAULT_BRICK_SIZE, bricks::LEVEL_ONE_APRON))
     }
 
     /// Levels 1… of the mip chain (built on first use; see [`pyramid`]).

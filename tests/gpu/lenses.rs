@@ -334,8 +334,9 @@ pub fn a_lens_that_compresses_nothing_takes_no_more_samples(gpu: &mut Gpu) {
 }
 
 /// Under a lens that compresses (a cubic border) with anti-aliasing, the samples of
-/// the mip chain skip empty space by their bricks' neighbourhoods
-/// (`Appearance::mip_brick_occupancy`): the picture is the one without skipping, and
+/// the mip chain skip empty space by their bricks' wider ranges (up to level 1) and
+/// neighbourhoods (`Appearance::mip_brick_occupancy`): the picture is the one without
+/// skipping, and
 /// the samples stay near the lens's without anti-aliasing (every mip sample was taken
 /// before: the bench's magnifier + AA had ×1.34 the samples of the plain view, now
 /// ×1.14, the magnifier alone ×0.91).
@@ -365,6 +366,7 @@ pub fn antialiased_lenses_skip_empty_space_exactly(gpu: &mut Gpu) {
     let (mean, _, max) = difference(&skipped, &every);
     assert!(mean < 0.05 && max <= 8, "skipping changed the anti-aliased picture: mean {mean}, max {max}");
     assert!(with.samples * 3 < all.samples, "{with:?} vs {all:?} without skipping");
-    // (×1.23 measured; ×1.43 with every mip sample taken.)
-    assert!(with.samples * 100 <= without.samples * 130, "{with:?} vs {without:?} without anti-aliasing");
+    // (×1.14 measured; ×1.23 with the neighbourhoods' bits for every level, ×1.43 with
+    // every mip sample taken.)
+    assert!(with.samples * 100 <= without.samples * 120, "{with:?} vs {without:?} without anti-aliasing");
 }

@@ -47,8 +47,8 @@ pub(super) fn draw_in(out: &mut PackedScene, a: usize, b: usize) {
             out.regions[a].flags &= !region_flags::OCCUPANCY;
             return;
         }
-        // (Both sets of bits: full-resolution samples' and mip samples'.)
-        let words = 2 * (ra.bricks.x * ra.bricks.y * ra.bricks.z).div_ceil(32) as usize;
+        // (Every set of bits: full-resolution samples' and mip samples'.)
+        let words = 3 * (ra.bricks.x * ra.bricks.y * ra.bricks.z).div_ceil(32) as usize;
         for k in 0..words {
             let bits = out.occupancy[rb.occupancy_offset as usize + k];
             out.occupancy[ra.occupancy_offset as usize + k] |= bits;
