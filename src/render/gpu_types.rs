@@ -102,6 +102,11 @@ pub mod features {
     pub const LENS_POLYGON: u32 = 1 << 22;
     pub const LENS_FEATURE: u32 = 1 << 23;
 
+    /// Some region samples scalar values of a volume in memory, which has a mip chain
+    /// (not a shader def: lenses' anti-aliasing reads nothing else, so the view's
+    /// pipeline has it only then, `render::pipeline::lens_features`).
+    pub const MIP_READS: u32 = 1 << 24;
+
     /// Shader def names of the lens kinds and shapes, by bit.
     pub const LENS_NAMES: [(u32, &str); 5] = [
         (LENS_MAGNIFIER, "HAS_MAGNIFIER"),

@@ -385,12 +385,22 @@ pub fn scene_features(regions: &[GpuRegion], overlaps: Overlaps) -> u32 {
         if r.flags & region_flags::ON_GRID != 0 {
             bits |= f::OWN_VALUES;
         }
+        if reads_mips(r) {
+            bits |= f::MIP_READS;
+        }
         // (Weights act on DVR samples only: with DVR in the shader.)
         if r.flags & region_flags::SELECTION != 0 && bits & f::DVR != 0 {
             bits |= f::SELECTION;
         }
     }
     bits
+}
+
+/// Whether region `r` samples scalar values of a volume in memory (the only samples
+/// that come from a mip chain: label codes are read whole, bricked volumes through
+/// their page tables).
+pub fn reads_mips(r: &GpuRegion) -> bool {
+    r.mode != mode::OFF && r.flags & region_flags::LABELS == 0 && r.bricked.x == 0
 }
 
 /// Packs one region; `levels` are the atlas offsets of its volume and mip levels.

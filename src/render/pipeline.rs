@@ -98,17 +98,18 @@ impl SpecializedRenderPipeline for RaycastPipeline {
 pub struct RaycastPipelineId(pub CachedRenderPipelineId);
 
 /// The per-view features of a view over a scene of `features`: lenses, and their
-/// anti-aliasing where the view asks for it and some region is in memory
-/// (anti-aliasing samples in-memory volumes' mip chains; a scene of bricked regions
-/// alone reads none, its rays take their level from their footprint instead, and the
-/// lens footprint per pixel cost the bench's 4× magnifier ×2.9 → ×1.9 for nothing,
-/// besides switching empty-space skipping off in the lens border).
+/// anti-aliasing where the view asks for it and some region samples scalar values in
+/// memory (`features::MIP_READS`: anti-aliasing samples in-memory volumes' mip chains;
+/// a scene of bricked regions alone reads none, its rays take their level from their
+/// footprint instead, and the lens footprint per pixel cost the bench's 4× magnifier
+/// ×2.9 → ×1.9 for nothing; label volumes are read whole, and the feature lens over
+/// the labelled head paid ×1.4 for nothing).
 /// With them, the kinds and shapes of `lenses` ([`lens_kinds`]).
 pub fn lens_features(features: u32, lenses: &[GpuLens], antialias: bool) -> u32 {
     let kinds = lens_kinds(lenses);
     match (lenses.is_empty(), antialias) {
         (true, _) => 0,
-        (false, true) if features & features::BRICKED_ONLY == 0 => features::LENSES | features::LENS_ANTIALIAS | kinds,
+        (false, true) if features & features::MIP_READS != 0 => features::LENSES | features::LENS_ANTIALIAS | kinds,
         (false, _) => features::LENSES | kinds,
     }
 }
@@ -144,7 +145,8 @@ pub fn prepare_pipelines(
     for (entity, target, settings) in &views {
         let count = (settings.lens_count as usize).min(settings.lenses.len());
         let lenses = lens_features(features, &settings.lenses[..count], settings.flags & super::gpu_types::view_flags::LENS_ANTIALIAS != 0);
-        let key = RaycastKey { format: target.main_texture_format(), features: features | lenses };
+        // (MIP_READS is no shader def.)
+        let key = RaycastKey { format: target.main_texture_format(), features: (features & !features::MIP_READS) | lenses };
         let id = pipelines.specialize(&cache, &pipeline, key);
         commands.entity(entity).insert(RaycastPipelineId(id));
     }
@@ -158,10 +160,13 @@ mod tests {
     fn lens_antialiasing_only_where_a_region_is_in_memory() {
         let (l, aa, m) = (features::LENSES, features::LENS_ANTIALIAS, features::LENS_MAGNIFIER);
         let one = [GpuLens::default()];
-        assert_eq!(lens_features(features::DVR, &[], true), 0);
-        assert_eq!(lens_features(features::DVR, &one, false), l | m);
-        assert_eq!(lens_features(features::DVR | features::BRICKED, &one, true), l | aa | m);
+        let reads = features::DVR | features::MIP_READS;
+        assert_eq!(lens_features(reads, &[], true), 0);
+        assert_eq!(lens_features(reads, &one, false), l | m);
+        assert_eq!(lens_features(reads | features::BRICKED, &one, true), l | aa | m);
+        // Bricked volumes alone, label volumes alone: nothing reads a mip chain.
         assert_eq!(lens_features(features::DVR | features::BRICKED | features::BRICKED_ONLY, &one, true), l | m);
+        assert_eq!(lens_features(features::DVR | features::LABELS, &one, true), l | m);
     }
 
     #[test]

@@ -69,6 +69,9 @@ pub fn mark_bricked(packed: &mut PackedScene, scene: &RenderScene, frames: &[Opt
         if packed.regions.iter().all(|r| r.bricked.x != 0) {
             packed.features |= features::BRICKED_ONLY;
         }
+        if !packed.regions.iter().any(crate::render::pack::reads_mips) {
+            packed.features &= !features::MIP_READS;
+        }
     }
     directory
 }

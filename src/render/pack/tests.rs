@@ -209,7 +209,14 @@ fn packs_regions_planes_luts_and_the_atlas() {
     assert_eq!(packed.lut.len(), LUT_ATLAS_WIDTH as usize);
     assert_eq!(packed.regions[0].dims, glam::Vec4::new(16.0, 16.0, 16.0, 255.0));
     use crate::render::gpu_types::features as f;
-    assert_eq!(packed.features, f::PROJECTION | f::SHADING | f::MULTI_REGION);
+    assert_eq!(packed.features, f::PROJECTION | f::SHADING | f::MULTI_REGION | f::MIP_READS);
+    // Regions reading a mip chain: scalar samples of volumes in memory, not label codes,
+    // not bricked volumes, not regions that draw nothing.
+    let scalar = packed.regions[1];
+    assert!(super::reads_mips(&scalar));
+    assert!(!super::reads_mips(&GpuRegion { flags: scalar.flags | region_flags::LABELS, ..scalar }));
+    assert!(!super::reads_mips(&GpuRegion { bricked: glam::UVec4::new(1, 0, 0, 0), ..scalar }));
+    assert!(!super::reads_mips(&GpuRegion { mode: mode::OFF, ..scalar }));
 }
 
 #[test]
