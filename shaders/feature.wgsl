@@ -16,7 +16,7 @@
 #import focal::bindings::regions
 #import focal::regions::{region_interval, in_hole, to_voxel}
 #import focal::sampling::nearest_code
-#import focal::lens::camera_ray
+#import focal::camera::camera_ray
 
 struct FeatureParams {
     cols: u32,

@@ -33,7 +33,7 @@
 #import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput
 #import focal::types::{Region, MODE_TWO_LEVEL, MODE_MIP, MODE_MIN_IP, MODE_ISO, REGION_LABELS, REGION_OCCUPANCY, VIEW_JITTER, VIEW_SKIP_EMPTY, VIEW_EARLY_TERMINATION, VIEW_DEBUG_RAYS, VIEW_DEBUG_COUNTS, EARLY_TERMINATION, MAX_RAY_REGIONS, REGION_CLUSTER}
 #import focal::bindings::{view, settings, scene, regions, depth_texture}
-#import focal::camera::{Ray, pixel_ray, scene_depth_t, jitter}
+#import focal::camera::{Ray, camera_ray, scene_depth_t, jitter}
 #import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod, level_varies}
 #import focal::regions::{region_interval, hole_interval, meets_sphere, pick_region, to_voxel, dir_to_voxel, world_step}
 #import focal::sampling::{trilinear, brick_occupied, brick_range, at_full_resolution, count_sample, ray_sample_count, set_lod}
@@ -59,7 +59,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
     lens_footprint(in.uv, ray);
 #endif
 #else
-    let ray = pixel_ray(in.uv);
+    let ray = camera_ray(in.uv);
 #endif
 #ifdef HAS_BRICKED
     prepare_ray_footprint(in.uv, ray);

@@ -23,6 +23,22 @@ fn pixel_ray(uv: vec2<f32>) -> Ray {
     return Ray(near, normalize(far - near));
 }
 
+fn is_perspective() -> bool {
+    return view.clip_from_view[3][3] < 0.5;
+}
+
+// The camera's own ray through uv, from the eye for a perspective view (as the CPU
+// camera, reference::Camera::ray), from the camera plane for an orthographic one.
+// (The ray caster's rays: from the near plane a frame of the head took 12 % longer on
+// llvmpipe, at the same samples.)
+fn camera_ray(uv: vec2<f32>) -> Ray {
+    let r = pixel_ray(uv);
+    if is_perspective() {
+        return Ray(view.world_position, r.dir);
+    }
+    return r;
+}
+
 // Ray parameter of the scene surface behind a pixel (infinity where there is none):
 // where the ray reaches the surface's depth along the view axis, which also holds for
 // rays bent by lenses.

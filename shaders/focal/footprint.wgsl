@@ -13,7 +13,8 @@
 #import focal::types::{Region, VIEW_LENS_CONTEXT_STEPS}
 #import focal::bindings::settings
 #import focal::camera::Ray
-#import focal::lens::{lens_ray, camera_ray, pixel_steps, Spread, spread_of, spread_extent}
+#import focal::camera::camera_ray
+#import focal::lens::{lens_ray, pixel_steps, Spread, spread_of, spread_extent}
 #import focal::bricked::set_bricked_level
 
 var<private> ray_spread: Spread;

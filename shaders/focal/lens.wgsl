@@ -7,7 +7,7 @@
 #import focal::types::{Lens, LENS_DATA}
 #import focal::sampling::set_lod
 #import focal::bindings::{view, settings, feature_fields}
-#import focal::camera::{Ray, pixel_ray}
+#import focal::camera::{Ray, pixel_ray, camera_ray}
 
 const LENS_MAGNIFIER: u32 = 0u;
 const LENS_SAMPLING: u32 = 1u;
@@ -33,20 +33,6 @@ fn to_lens(uv: vec2<f32>) -> vec2<f32> {
 
 fn lens_uv(s: vec2<f32>) -> vec2<f32> {
     return vec2((s.x / view_aspect() + 1.0) * 0.5, (1.0 - s.y) * 0.5);
-}
-
-fn is_perspective() -> bool {
-    return view.clip_from_view[3][3] < 0.5;
-}
-
-// The camera's own ray through uv, from the eye for a perspective view (as the CPU
-// camera), from the camera plane for an orthographic one.
-fn camera_ray(uv: vec2<f32>) -> Ray {
-    let r = pixel_ray(uv);
-    if is_perspective() {
-        return Ray(view.world_position, r.dir);
-    }
-    return r;
 }
 
 fn outline_vertex(base: u32, i: u32) -> vec2<f32> {

@@ -307,7 +307,7 @@ pub fn feature_lens_matches_the_reference(gpu: &mut Gpu) {
         assert_matches(&format!("lens_feature{}", if ortho { "_ortho" } else { "" }), &g, &c);
         let changed = g.pixels().zip(plain.pixels()).filter(|(p, q)| (0..3).any(|k| p[k].abs_diff(q[k]) > 10)).count();
         assert!(changed > 50, "the feature lens changed only {changed} pixels");
-        // (Rays from the eye under lenses, from the near plane without: not bit-equal.)
+        // (Rays from the eye with lenses and without, the lens code's arithmetic apart.)
         let bent = none.pixels().zip(plain.pixels()).filter(|(p, q)| (0..3).any(|k| p[k].abs_diff(q[k]) > 10)).count();
         assert_eq!(bent, 0, "a feature out of view bends no ray");
     }
