@@ -308,13 +308,17 @@ impl Appearance {
         match &self.lookup {
             Lookup::Transfer(tf) if matches!(self.mode, Mode::Dvr | Mode::GradientDvr | Mode::Context) => {
                 let lut = Lut::for_volume(tf, volume);
-                let map = volume.values.clone();
-                Some(Box::new(move |lo, hi| lut.max_opacity_between(map.to_real(lo as f64), map.to_real(hi as f64)) > 0.0))
+                let (visible, map) = (lut.visible_texels(), volume.values.clone());
+                Some(Box::new(move |lo, hi| {
+                    let (i0, i1) = lut.texels_between(map.to_real(lo as f64), map.to_real(hi as f64));
+                    visible.any(i0, i1)
+                }))
             }
             Lookup::Transfer(_) => None,
             Lookup::Labels(styles) => {
                 let table = styles.bake(volume.stats.code_max as usize + 1);
-                Some(Box::new(move |lo, hi| table.get(lo as usize..=hi as usize).is_some_and(|t| t.iter().any(|c| c[3] > 0.0))))
+                let visible = crate::transfer::visible::VisibleEntries::new(table.iter().map(|c| c[3] > 0.0));
+                Some(Box::new(move |lo, hi| visible.any(lo as usize, hi as usize)))
             }
         }
     }

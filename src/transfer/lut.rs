@@ -10,6 +10,7 @@
 
 use super::color::srgb3_to_linear;
 use super::function::TransferFunction;
+use super::visible::VisibleEntries;
 use crate::volume::Volume;
 
 /// Number of entries used for 8-bit volumes (one per code) and for 16-bit volumes.
@@ -98,11 +99,22 @@ impl Lut {
     /// Largest opacity of any texel that a sample between the real values `lo..=hi` can
     /// touch (for empty-space skipping: zero means the range is invisible).
     pub fn max_opacity_between(&self, lo: f64, hi: f64) -> f32 {
+        let (i0, i1) = self.texels_between(lo, hi);
+        self.rgba[i0..=i1].iter().map(|c| c[3]).fold(0.0, f32::max)
+    }
+
+    /// The texels `i0..=i1` a sample between the real values `lo..=hi` can touch.
+    pub fn texels_between(&self, lo: f64, hi: f64) -> (usize, usize) {
         let n = self.rgba.len();
         let texel = |v: f64| (self.texcoord(v) * n as f32 - 0.5).clamp(0.0, (n - 1) as f32);
         let (a, b) = (texel(lo.min(hi)), texel(lo.max(hi)));
-        let (i0, i1) = (a.floor() as usize, (b.ceil() as usize).min(n - 1));
-        self.rgba[i0..=i1].iter().map(|c| c[3]).fold(0.0, f32::max)
+        (a.floor() as usize, (b.ceil() as usize).min(n - 1))
+    }
+
+    /// Which texels have any opacity, for [`Self::max_opacity_between`]` > 0` in
+    /// constant time (with [`Self::texels_between`]).
+    pub fn visible_texels(&self) -> VisibleEntries {
+        VisibleEntries::new(self.rgba.iter().map(|c| c[3] > 0.0))
     }
 }
 
@@ -155,5 +167,13 @@ mod tests {
         assert!(lut.max_opacity_between(50.0, 70.0) > 0.7);
         // Reversed bounds work too.
         assert!(lut.max_opacity_between(70.0, 50.0) > 0.7);
+        // The constant-time answer agrees with the bound everywhere.
+        let visible = lut.visible_texels();
+        for a in (-10..110).step_by(3) {
+            for b in (-10..110).step_by(7) {
+                let (i0, i1) = lut.texels_between(a as f64, b as f64);
+                assert_eq!(visible.any(i0, i1), lut.max_opacity_between(a as f64, b as f64) > 0.0, "{a}..{b}");
+            }
+        }
     }
 }

@@ -9,6 +9,7 @@ pub mod labels;
 pub mod lut;
 pub mod opacity;
 pub mod presets;
+pub mod visible;
 
 pub use function::{ColorPoint, OpacityPoint, TransferFunction, ValueSpace};
 pub use labels::{LabelStyle, LabelTransfer};
