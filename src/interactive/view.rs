@@ -167,7 +167,7 @@ fn scene_change(a: &RenderScene, b: &RenderScene) -> Option<&'static str> {
         Some("the regions")
     } else if a.appearances != b.appearances {
         Some("the looks")
-    } else if (RenderScene { regions: Vec::new(), ..a.clone() }) != (RenderScene { regions: Vec::new(), ..b.clone() }) {
+    } else if !a.equal_but_regions(b) {
         Some("the scene")
     } else {
         None
