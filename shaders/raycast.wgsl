@@ -39,8 +39,8 @@
 #import focal::sampling::{trilinear, brick_occupied, brick_range, at_full_resolution, count_sample, ray_sample_count, set_lod}
 #import focal::bricked::page_lookup_count
 #import focal::selection::{region_weight, set_weight, pick_weight, set_companion, no_companion}
-#import focal::samples::{is_projection, dvr_sample, dvr_classify, dvr_classified, adds_something, is_dvr_like, iso_hit, emit_projection, projection_takes}
-#import focal::segments::{DONE, HAS_PREV, PAIRABLE, CLOSES, Segment, segment_t, segment_point, segment_point_at, past_brick, past_empty_bricks, past_empty_bricks_at, past_empty_pair, cut_intervals, compact_intervals, leaves}
+#import focal::samples::{is_projection, dvr_sample, dvr_classify, dvr_classify_at, dvr_classified, adds_something, is_dvr_like, iso_hit, emit_projection, projection_takes}
+#import focal::segments::{DONE, HAS_PREV, PAIRABLE, CLOSES, Segment, segment_t, segment_point, segment_point_at, past_brick, past_brick_at, past_empty_bricks, past_empty_bricks_at, past_empty_pair, cut_intervals, compact_intervals, leaves}
 #ifdef HAS_TWO_LEVEL
 #import focal::two_level::{NO_PART, Open, fresh, close_segment, end_segment, two_level_sample, open_part}
 #endif
@@ -585,16 +585,19 @@ fn dvr_run(r: Region, g: Segment, kk_in: f32, k_end: f32, ratio: f32, ray: Ray, 
         // gradient and the shading of every sample, whether it added anything or not).
         var q = segment_point_at(g, kk, lensed);
         var c = dvr_classify(r, q);
-        let k_last = min(k_end, past_brick(r, g, q, kk) - 1.0);
+        // (dvr_classify looked q up: neither the brick's exit nor the gradient looks
+        // again.)
+        let k_last = min(k_end, past_brick_at(r, g, q, kk, true) - 1.0);
         for (var clear_steps = 0u; clear_steps < scene.max_steps; clear_steps++) {
             if adds_something(c) || kk >= k_last {
                 break;
             }
             kk += 1.0;
             q = segment_point_at(g, kk, lensed);
-            c = dvr_classify(r, q);
+            // (Up to k_last the samples lie in q's brick or sub-block, as looked up.)
+            c = dvr_classify_at(r, q, true);
         }
-        acc = dvr_classified(r, q, c.v, c.rgba, c.weight, ratio, ray, segment_t(g, kk), acc);
+        acc = dvr_classified(r, q, c.v, c.rgba, c.weight, ratio, ray, segment_t(g, kk), acc, true);
         kk += 1.0;
     }
     return acc;

@@ -50,6 +50,13 @@ var<private> bricked_gradient_norm: f32 = 1.0;
 // them after 8^G + … + 8^(G−c+1) (page_table::block_offset). Per ray, not per look-up.
 var<private> bricked_cap: u32 = 0u;
 var<private> bricked_block_offset: u32 = 0u;
+// What every look-up of the ray reads alike, read once with its level: the page tree's
+// first word, the level-0 and level-G brick counts, the atlas's slot edge, the masks'
+// first word and the slot grid's x and y.
+var<private> bricked_tree: u32 = 0u;
+var<private> bricked_n0: vec3<u32>;
+var<private> bricked_ng: vec3<u32>;
+var<private> bricked_atlas: vec4<u32>;
 
 // Sets the ray's level l (of 0 … C) in bricked region r, and the finest level it reads
 // (`cap`: l, or under a lens with context steps the lens's footprint's level where it is
@@ -62,6 +69,11 @@ fn set_bricked_level(r: Region, l: f32, cap: f32) -> f32 {
     bricked_block_offset = ((1u << (3u * (g + 1u))) - (1u << (3u * (g - bricked_cap + 1u)))) / 7u;
     let tree = pages[PAGE_HEADER + r.bricked.x - 1u];
     bricked_gradient_norm = bitcast<f32>(pages[tree - GRADIENT_NORMS + u32(l)]);
+    bricked_tree = tree;
+    bricked_n0 = brick_count(r.bricked_dims.xyz, r.bricked.y);
+    bricked_ng = brick_count(level_dims(r.bricked_dims.xyz, g), r.bricked.y);
+    bricked_atlas = vec4(pages[3], pages[7], pages[0], pages[1]);
+    bc_inv = vec3(bitcast<f32>(pages[4]), bitcast<f32>(pages[5]), bitcast<f32>(pages[6]));
     return f;
 }
 
@@ -103,14 +115,14 @@ fn page_lookup_count() -> u32 {
 // Looks q0 (level-0 index) up in r's page table.
 fn bricked_locate(r: Region, q0: vec3<f32>) {
     page_lookups += 1u;
-    let tree = pages[PAGE_HEADER + r.bricked.x - 1u];
+    let tree = bricked_tree;
     let size = r.bricked.y;
     let d0 = r.bricked_dims.xyz;
     let g = r.bricked_dims.w;
     let fsize = f32(size);
-    let b0 = min(vec3<u32>(max(floor((clamp(q0, vec3(0.0), vec3<f32>(d0) - 1.0) + 0.5) / fsize), vec3(0.0))), brick_count(d0, size) - 1u);
+    let b0 = min(vec3<u32>(max(floor((clamp(q0, vec3(0.0), vec3<f32>(d0) - 1.0) + 0.5) / fsize), vec3(0.0))), bricked_n0 - 1u);
     let bg = b0 >> vec3(g);
-    let ng = brick_count(level_dims(d0, g), size);
+    let ng = bricked_ng;
     var word = pages[tree + (bg.z * ng.y + bg.y) * ng.x + bg.x];
     // (The block's words of the ray's level c.)
     let c = bricked_cap;
@@ -127,14 +139,11 @@ fn bricked_locate(r: Region, q0: vec3<f32>) {
     bc_code = f32(word & 0xffffu);
     bc_dims = vec3<f32>(level_dims(d0, k));
     let slot = vec3<u32>(word & 127u, (word >> SLOT_BITS) & 127u, (word >> (2u * SLOT_BITS)) & 127u);
-    let edge = pages[3];
+    let edge = bricked_atlas.x;
     bc_origin = vec3<f32>(bk * size);
     bc_shift = vec3<f32>(slot * edge) + f32(r.bricked.z) + 0.5 - bc_origin;
-    let gx = pages[0];
-    let gy = pages[1];
-    let mask_at = pages[7] + 2u * (slot.x + gx * (slot.y + gy * slot.z));
+    let mask_at = bricked_atlas.y + 2u * (slot.x + bricked_atlas.z * (slot.y + bricked_atlas.w * slot.z));
     bc_mask = vec2<u32>(pages[mask_at], pages[mask_at + 1u]);
-    bc_inv = vec3(bitcast<f32>(pages[4]), bitcast<f32>(pages[5]), bitcast<f32>(pages[6]));
     // The box of level m's brick, open past the level's first and last bricks.
     let bm = b0 >> vec3(m);
     let span = f32(size << m);

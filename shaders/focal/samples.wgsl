@@ -9,7 +9,7 @@
 #import focal::bindings::{settings, scene}
 #import focal::camera::Ray
 #import focal::regions::to_voxel
-#import focal::sampling::{trilinear, trilinear_with_doi, nearest_code, index_gradient, gradient_norm, count_sample}
+#import focal::sampling::{trilinear, trilinear_at, trilinear_with_doi, nearest_code, index_gradient, index_gradient_at, gradient_norm, count_sample}
 #import focal::transfer::{classify, classify_label, classify_lambda, correct_opacity, filtered_table}
 #import focal::shading::{shade, shade_with, blinn_phong}
 #import focal::context::{context_opacity, eye_distance}
@@ -32,11 +32,11 @@ fn shaded(r: Region, c: vec3<f32>, q: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 }
 
 // The value at q: fetched with the degree of interest (vd.x) or on its own.
-fn value_at(r: Region, q: vec3<f32>, vd: vec2<f32>) -> f32 {
+fn value_at(r: Region, q: vec3<f32>, vd: vec2<f32>, located: bool) -> f32 {
 #ifdef DOI_CHANNEL
     return vd.x;
 #else
-    return trilinear(r, q);
+    return trilinear_at(r, q, located);
 #endif
 }
 
@@ -45,7 +45,7 @@ fn value_at(r: Region, q: vec3<f32>, vd: vec2<f32>) -> f32 {
 // fetched once for shading and modulation.
 fn dvr_sample(r: Region, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
     let c = dvr_classify(r, q);
-    return dvr_classified(r, q, c.v, c.rgba, c.weight, ratio, ray, t, acc);
+    return dvr_classified(r, q, c.v, c.rgba, c.weight, ratio, ray, t, acc, true);
 }
 
 // A DVR sample classified: its value (0 for labels), colour and opacity, and the
@@ -68,6 +68,12 @@ fn adds_something(c: Classified) -> bool {
 
 // The first half of dvr_sample: the sample at q classified.
 fn dvr_classify(r: Region, q: vec3<f32>) -> Classified {
+    return dvr_classify_at(r, q, false);
+}
+
+// dvr_classify where `located` (a literal) says the last page look-up's answer holds for
+// q (sampling::trilinear_at; labels and the degree-of-interest channel look up anyway).
+fn dvr_classify_at(r: Region, q: vec3<f32>, located: bool) -> Classified {
     count_sample();
     var rgba: vec4<f32>;
     var v = 0.0;
@@ -80,11 +86,11 @@ fn dvr_classify(r: Region, q: vec3<f32>) -> Classified {
     if (r.flags & REGION_LABELS) != 0u {
         rgba = classify_label(r, nearest_code(r, q), scene.lut_atlas_width);
     } else {
-        v = value_at(r, q, vd);
+        v = value_at(r, q, vd, located);
         rgba = classify(r, v, scene.lut_atlas_width);
     }
 #else
-    v = value_at(r, q, vd);
+    v = value_at(r, q, vd, located);
     rgba = classify(r, v, scene.lut_atlas_width);
 #endif
     var w = 1.0;
@@ -100,7 +106,9 @@ fn dvr_classify(r: Region, q: vec3<f32>) -> Classified {
 // the 1 − weight left over (render::pack::companions: the same volume under the same
 // map, a DVR look with the same shading, so it shares the gradient and the Blinn-Phong
 // terms; on llvmpipe a second shading of its own cost a third of the frame).
-fn dvr_classified(r: Region, q: vec3<f32>, v: f32, rgba: vec4<f32>, weight: f32, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
+// `located` (a literal): the last page look-up was of q, as after dvr_classify
+// (sampling::index_gradient_at).
+fn dvr_classified(r: Region, q: vec3<f32>, v: f32, rgba: vec4<f32>, weight: f32, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>, located: bool) -> vec4<f32> {
     let a = rgba.a * weight;
     var other = vec4(0.0);
 #ifdef COMPANION
@@ -129,7 +137,7 @@ fn dvr_classified(r: Region, q: vec3<f32>, v: f32, rgba: vec4<f32>, weight: f32,
     needs_gradient = needs_gradient || (r.flags & REGION_SHADING) != 0u;
 #endif
     if needs_gradient {
-        let gi = index_gradient(r, q, scene.lut_atlas_width);
+        let gi = index_gradient_at(r, q, scene.lut_atlas_width, located);
         let g = (r.normal_matrix * vec4(gi, 0.0)).xyz;
         let magnitude = min(length(gi) / gradient_norm(r), 1.0);
 #ifdef HAS_GRADIENT_MODULATION

@@ -89,8 +89,16 @@ fn trilinear_memory(r: Region, q: vec3<f32>) -> f32 {
 // code (invisible under every look of the volume), else the coarse volume (never with
 // BRICKED_ONLY: the coarse level's bricks are in the atlas).
 fn bricked_sample(r: Region, q: vec3<f32>) -> f32 {
+    return bricked_sample_at(r, q, false);
+}
+
+// bricked_sample where `located` (a literal) says the last page look-up's answer holds
+// for q (q lies in the brick or sub-block it found: index_gradient_at).
+fn bricked_sample_at(r: Region, q: vec3<f32>, located: bool) -> f32 {
     let q0 = level_zero(r, q);
-    bricked_locate(r, q0);
+    if !located {
+        bricked_locate(r, q0);
+    }
 #ifdef BRICKED_ONLY
     return select(bc_code / r.dims.w, textureSampleLevel(brick_cache, volume_sampler, bricked_uvw(q0), 0.0).r, bc_kind == BRICKED_TEXEL);
 #else
@@ -109,12 +117,18 @@ fn bricked_sample(r: Region, q: vec3<f32>) -> f32 {
 // and the volume atlas's path is left out: llvmpipe runs both sides of a branch, which
 // made every sample of a bricked volume twice as dear as one in memory.
 fn trilinear(r: Region, q: vec3<f32>) -> f32 {
+    return trilinear_at(r, q, false);
+}
+
+// trilinear where `located` (a literal) says the last page look-up's answer holds for q
+// (bricked_sample_at).
+fn trilinear_at(r: Region, q: vec3<f32>, located: bool) -> f32 {
 #ifdef BRICKED_ONLY
-    return bricked_sample(r, q);
+    return bricked_sample_at(r, q, located);
 #else
 #ifdef HAS_BRICKED
     if is_bricked(r) {
-        return bricked_sample(r, q);
+        return bricked_sample_at(r, q, located);
     }
 #endif
     return trilinear_memory(r, q);
@@ -180,6 +194,14 @@ fn label_alpha(r: Region, q: vec3<f32>, atlas_width: u32) -> f32 {
 // Central-difference gradient in normalised units per voxel (index axes). Label
 // volumes use the gradient of the label opacity field.
 fn index_gradient(r: Region, q: vec3<f32>, atlas_width: u32) -> vec3<f32> {
+    return index_gradient_at(r, q, atlas_width, false);
+}
+
+// index_gradient where `located` (a literal at each call site) says the last page
+// look-up was of q itself (the sample's own value was just fetched): a bricked region
+// then takes its answer as it stands. (On llvmpipe a look-up is a dozen loads and a
+// page walk, and a shaded DVR sample of a bricked volume made four at the same place.)
+fn index_gradient_at(r: Region, q: vec3<f32>, atlas_width: u32, located: bool) -> vec3<f32> {
     var g = vec3(0.0);
 #ifdef HAS_LABELS
     if (r.flags & REGION_LABELS) != 0u {
@@ -197,7 +219,9 @@ fn index_gradient(r: Region, q: vec3<f32>, atlas_width: u32) -> vec3<f32> {
     if is_bricked(r) {
         h = bricked_step_factor();
         let q0 = level_zero(r, q);
-        bricked_locate(r, q0);
+        if !located {
+            bricked_locate(r, q0);
+        }
 #ifdef BRICKED_ONLY
         // (An empty brick's value is one code throughout.)
         return select(vec3(0.0), bricked_gradient(r, q0, h), bc_kind == BRICKED_TEXEL);
@@ -276,9 +300,17 @@ fn brick_occupied(r: Region, q: vec3<f32>) -> bool {
 
 // Ray parameter where the ray leaves q's brick (voxel-space direction qd per unit t).
 fn brick_exit(r: Region, q: vec3<f32>, qd: vec3<f32>, t: f32) -> f32 {
+    return brick_exit_at(r, q, qd, t, false);
+}
+
+// brick_exit where `located` (a literal) says the last page look-up was of q
+// (index_gradient_at).
+fn brick_exit_at(r: Region, q: vec3<f32>, qd: vec3<f32>, t: f32, located: bool) -> f32 {
 #ifdef BRICKED_ONLY
     let q0 = level_zero(r, q);
-    bricked_locate(r, q0);
+    if !located {
+        bricked_locate(r, q0);
+    }
     let exit = bricked_box_exit(r, q, qd, t, 3.4e38);
     return select(exit, sub_block_exit(r, q0, q, qd, t, exit), bc_kind == BRICKED_TEXEL);
 #else
@@ -290,7 +322,9 @@ fn brick_exit(r: Region, q: vec3<f32>, qd: vec3<f32>, t: f32) -> f32 {
 #ifdef HAS_BRICKED
     if is_bricked(r) {
         let q0 = level_zero(r, q);
-        bricked_locate(r, q0);
+        if !located {
+            bricked_locate(r, q0);
+        }
         if bc_kind == BRICKED_TEXEL {
             return sub_block_exit(r, q0, q, qd, t, bricked_box_exit(r, q, qd, t, 3.4e38));
         }

@@ -7,7 +7,7 @@
 #import focal::types::{Region, MAX_RAY_REGIONS}
 #import focal::bindings::{scene, regions}
 #import focal::lens::update_lod
-#import focal::sampling::{brick_occupied, brick_exit}
+#import focal::sampling::{brick_occupied, brick_exit_at}
 
 // Per-interval state bits: the region is done with; it has a previous sample (iso);
 // it is DVR-like (two such share the DVR loop); it composites at its end (projections,
@@ -53,7 +53,13 @@ fn segment_point_at(g: Segment, kk: f32, lensed: bool) -> vec3<f32> {
 
 // Index of the first sample past the brick that holds sample kk (at q).
 fn past_brick(r: Region, g: Segment, q: vec3<f32>, kk: f32) -> f32 {
-    return max(kk + 1.0, ceil((brick_exit(r, q, g.qd, segment_t(g, kk)) - g.t_start) / g.step - g.j));
+    return past_brick_at(r, g, q, kk, false);
+}
+
+// past_brick where the last page look-up was of q when `located` (a literal:
+// sampling::brick_exit_at).
+fn past_brick_at(r: Region, g: Segment, q: vec3<f32>, kk: f32, located: bool) -> f32 {
+    return max(kk + 1.0, ceil((brick_exit_at(r, q, g.qd, segment_t(g, kk), located) - g.t_start) / g.step - g.j));
 }
 
 // The first sample from kk on (at most k_end + 1) that lies in an occupied brick (for
@@ -76,7 +82,8 @@ fn past_empty_bricks_at(r: Region, g: Segment, kk_in: f32, k_end: f32, lensed: b
         if brick_occupied(r, q) {
             break;
         }
-        kk = past_brick(r, g, q, kk);
+        // (brick_occupied looked q up.)
+        kk = past_brick_at(r, g, q, kk, true);
     }
     return kk;
 }

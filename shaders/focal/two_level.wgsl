@@ -221,7 +221,7 @@ fn two_level_sample(r: Region, labels: Region, part: ptr<function, Region>, open
 #endif
 #ifdef HAS_DVR
     let own = own_value(r, labels, q, v);
-    out = dvr_classified(*part, q, own, classify(*part, own, scene.lut_atlas_width), 1.0, ratio, ray, t, out);
+    out = dvr_classified(*part, q, own, classify(*part, own, scene.lut_atlas_width), 1.0, ratio, ray, t, out, false);
 #endif
     return out;
 }
