@@ -110,15 +110,27 @@ fn every_shader_variant_composes_and_validates() {
             && (bits & own == 0
                 || (bits & bit("HAS_TWO_LEVEL") != 0 && ((bits & !own).count_ones() <= 3 || (bits | bricked | bit("HAS_HOLES")) == full)))
     };
-    for bits in (0u32..(1 << DEFS.len())).filter(|b| possible(*b)) {
-        let defs: HashMap<String, ShaderDefValue> = DEFS
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| bits & (1 << i) != 0)
-            .map(|(_, d)| (d.to_string(), ShaderDefValue::Bool(true)))
-            .collect();
-        compose_and_validate("shaders/raycast.wgsl", defs);
-    }
+    let variants: Vec<u32> = (0u32..(1 << DEFS.len())).filter(|b| possible(*b)).collect();
+    // (On every core: the variants are independent, and one after another they were
+    // six of the suite's minutes. A variant that fails panics its thread, and the scope
+    // the test.)
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    std::thread::scope(|scope| {
+        for first in 0..threads {
+            let variants = &variants;
+            scope.spawn(move || {
+                for bits in variants.iter().skip(first).step_by(threads) {
+                    let defs: HashMap<String, ShaderDefValue> = DEFS
+                        .iter()
+                        .enumerate()
+                        .filter(|(i, _)| bits & (1 << i) != 0)
+                        .map(|(_, d)| (d.to_string(), ShaderDefValue::Bool(true)))
+                        .collect();
+                    compose_and_validate("shaders/raycast.wgsl", defs);
+                }
+            });
+        }
+    });
 }
 
 /// The lens kinds' and shapes' defs (mirrors `render::gpu_types::features::LENS_NAMES`).
