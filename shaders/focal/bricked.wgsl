@@ -50,12 +50,10 @@ var<private> bricked_gradient_norm: f32 = 1.0;
 // them after 8^G + … + 8^(G−c+1) (page_table::block_offset). Per ray, not per look-up.
 var<private> bricked_cap: u32 = 0u;
 var<private> bricked_block_offset: u32 = 0u;
-// What every look-up of the ray reads alike, read once with its level: the page tree's
-// first word, the level-0 and level-G brick counts, the atlas's slot edge, the masks'
-// first word and the slot grid's x and y.
-var<private> bricked_tree: u32 = 0u;
-var<private> bricked_n0: vec3<u32>;
-var<private> bricked_ng: vec3<u32>;
+// The brick atlas's header, the same for every look-up of every region, read once with
+// the ray's level: the slot edge, the masks' first word and the slot grid's x and y.
+// (Only the atlas's words: a region's own, such as its page tree, are read per look-up,
+// since a ray may cross bricked regions of different volumes.)
 var<private> bricked_atlas: vec4<u32>;
 
 // Sets the ray's level l (of 0 … C) in bricked region r, and the finest level it reads
@@ -69,9 +67,6 @@ fn set_bricked_level(r: Region, l: f32, cap: f32) -> f32 {
     bricked_block_offset = ((1u << (3u * (g + 1u))) - (1u << (3u * (g - bricked_cap + 1u)))) / 7u;
     let tree = pages[PAGE_HEADER + r.bricked.x - 1u];
     bricked_gradient_norm = bitcast<f32>(pages[tree - GRADIENT_NORMS + u32(l)]);
-    bricked_tree = tree;
-    bricked_n0 = brick_count(r.bricked_dims.xyz, r.bricked.y);
-    bricked_ng = brick_count(level_dims(r.bricked_dims.xyz, g), r.bricked.y);
     bricked_atlas = vec4(pages[3], pages[7], pages[0], pages[1]);
     bc_inv = vec3(bitcast<f32>(pages[4]), bitcast<f32>(pages[5]), bitcast<f32>(pages[6]));
     return f;
@@ -115,14 +110,14 @@ fn page_lookup_count() -> u32 {
 // Looks q0 (level-0 index) up in r's page table.
 fn bricked_locate(r: Region, q0: vec3<f32>) {
     page_lookups += 1u;
-    let tree = bricked_tree;
+    let tree = pages[PAGE_HEADER + r.bricked.x - 1u];
     let size = r.bricked.y;
     let d0 = r.bricked_dims.xyz;
     let g = r.bricked_dims.w;
     let fsize = f32(size);
-    let b0 = min(vec3<u32>(max(floor((clamp(q0, vec3(0.0), vec3<f32>(d0) - 1.0) + 0.5) / fsize), vec3(0.0))), bricked_n0 - 1u);
+    let b0 = min(vec3<u32>(max(floor((clamp(q0, vec3(0.0), vec3<f32>(d0) - 1.0) + 0.5) / fsize), vec3(0.0))), brick_count(d0, size) - 1u);
     let bg = b0 >> vec3(g);
-    let ng = bricked_ng;
+    let ng = brick_count(level_dims(d0, g), size);
     var word = pages[tree + (bg.z * ng.y + bg.y) * ng.x + bg.x];
     // (The block's words of the ray's level c.)
     let c = bricked_cap;

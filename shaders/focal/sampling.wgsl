@@ -298,13 +298,8 @@ fn brick_occupied(r: Region, q: vec3<f32>) -> bool {
 #endif
 }
 
-// Ray parameter where the ray leaves q's brick (voxel-space direction qd per unit t).
-fn brick_exit(r: Region, q: vec3<f32>, qd: vec3<f32>, t: f32) -> f32 {
-    return brick_exit_at(r, q, qd, t, false);
-}
-
-// brick_exit where `located` (a literal) says the last page look-up was of q
-// (index_gradient_at).
+// Ray parameter where the ray leaves q's brick (voxel-space direction qd per unit t);
+// `located` (a literal) says the last page look-up was of q (index_gradient_at).
 fn brick_exit_at(r: Region, q: vec3<f32>, qd: vec3<f32>, t: f32, located: bool) -> f32 {
 #ifdef BRICKED_ONLY
     let q0 = level_zero(r, q);
