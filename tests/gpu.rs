@@ -369,7 +369,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 34] = [
+    let tests: [GpuTest; 35] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -407,6 +407,10 @@ fn main() {
         ("two_level_on_bricked_data_matches_memory", bricked::two_level_on_bricked_data_matches_memory),
         ("exploded_parts_on_bricked_data_match_memory", bricked::exploded_parts_on_bricked_data_match_memory),
         ("context_on_bricked_data_normalises_by_the_levels_gradients", bricked::context_on_bricked_data_normalises_by_the_levels_gradients),
+        (
+            "a_still_bricked_view_keeps_its_frame_until_something_changes",
+            bricked::a_still_bricked_view_keeps_its_frame_until_something_changes,
+        ),
     ];
     let filter: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     let mut failed = Vec::new();

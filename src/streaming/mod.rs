@@ -5,7 +5,8 @@
 //!   through a cache), budgets, what the renderer is told each frame, the status;
 //! - [`select`]: the bricks each view wants, from pixel footprints through every region
 //!   that shows the volume and the magnification of lenses over it;
-//! - [`systems`]: each frame, asking the cache and publishing the bricks to draw.
+//! - [`systems`]: each frame, asking the cache and publishing the bricks to draw;
+//! - [`unchanged`]: a volume's last frame kept while nothing it depends on changed.
 //!
 //! The renderer (`render::bricked`) places the drawn bricks in its atlas within a
 //! per-frame upload budget and builds the page table the ray caster samples through.
@@ -13,6 +14,7 @@
 pub mod bricked;
 pub mod select;
 pub mod systems;
+pub mod unchanged;
 
 use bevy::prelude::*;
 

@@ -11,13 +11,14 @@ use glam::Affine3A;
 
 use super::bricked::{BrickFrame, BrickedDataset, BrickedScene, StreamBudget, StreamStatus};
 use super::select::{Magnified, Seen, ViewFrame, wanted};
+use super::unchanged::{Inputs, LastFrames, VolumeCounts};
 use crate::dataset::{DataBox, Dataset, SceneRegions, VolumeView};
 use crate::lens::ViewLenses;
 use crate::lens::stack::Effect;
 use crate::region::appearance::CodeVisibility;
 use crate::region::{Appearance, RenderScene};
 use crate::volume::Volume;
-use crate::volume::source::cache::BrickKey;
+use crate::volume::source::cache::{BrickKey, CacheStats};
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -91,7 +92,10 @@ impl VisibilityTests {
     }
 }
 
-/// Asks for the bricks the views want and publishes what to draw ([`BrickedScene`]).
+/// Asks for the bricks the views want and publishes what to draw ([`BrickedScene`]);
+/// a volume whose views, regions, looks and cache did not change keeps its last frame
+/// ([`super::unchanged`]).
+#[allow(clippy::too_many_arguments)]
 pub fn stream_bricks(
     mut datasets: Query<(&Dataset, &mut BrickedDataset)>,
     regions: Res<SceneRegions>,
@@ -100,94 +104,131 @@ pub fn stream_bricks(
     status: Res<StreamStatus>,
     mut out: ResMut<BrickedScene>,
     mut visibility: Local<VisibilityTests>,
+    mut last: Local<LastFrames>,
 ) {
     let scene = &regions.scene;
     let frames = view_frames(&views);
     let mut volumes = vec![None; scene.volumes.len()];
-    let (mut want_total, mut resident_total, mut pending, mut failed, mut finest, mut count) = (0, 0, 0, 0, None::<usize>, 0);
+    let mut total = VolumeCounts::default();
+    let mut count = 0;
     for (v, entity) in regions.datasets.iter().enumerate() {
         let Ok((dataset, mut bricked)) = datasets.get_mut(*entity) else { continue };
         let Some(volume) = scene.volumes.get(v) else { continue };
-        let bits = bricked.bits();
         count += 1;
-        let per_brick = bricked.cache.layout().stored().pow(3) as u64 * (bits as u64 / 8);
-        let cap = budget.gpu_bricks(bits).min((budget.cpu_bytes / per_brick.max(1)) as usize) * 3 / 4;
-        let seen = seen_by(scene, v, volume.grid.world_to_index().inverse());
-        let want = wanted(&bricked.levels, bricked.coarse, bricked.cache.layout(), &seen, &frames, cap.max(1));
-        bricked.cache.request(&want);
-        finest = want.iter().map(|k| k.level as usize).min().into_iter().chain(finest).min();
-        // The wanted bricks and their ancestors below the coarse level, coarsest first.
-        let mut keys: BTreeSet<(std::cmp::Reverse<u8>, BrickKey)> = BTreeSet::new();
-        for k in &want {
-            let mut a = *k;
-            while (a.level as usize) < bricked.coarse && keys.insert((std::cmp::Reverse(a.level), a)) {
-                a = a.parent();
+        let per_brick = bricked.cache.layout().stored().pow(3) as u64 * (bricked.bits() as u64 / 8);
+        let cap = budget.gpu_bricks(bricked.bits()).min((budget.cpu_bytes / per_brick.max(1)) as usize) * 3 / 4;
+        let inputs = Inputs {
+            volume: volume.clone(),
+            frames: frames.clone(),
+            seen: seen_by(scene, v, volume.grid.world_to_index().inverse()),
+            looks: scene.regions.iter().filter(|r| r.volume == v).filter_map(|r| scene.appearances.get(r.appearance)).cloned().collect(),
+            cap,
+        };
+        let (frame, counts) = match last.unchanged(*entity, &inputs, &bricked.cache.stats()) {
+            Some(kept) => kept,
+            None => {
+                let (frame, counts, cache) = select_frame(dataset, &mut bricked, &inputs, &mut visibility);
+                last.keep(*entity, inputs, cache, frame.clone(), counts);
+                (frame, counts)
             }
-        }
-        let looks: Vec<&Appearance> =
-            scene.regions.iter().filter(|r| r.volume == v).filter_map(|r| scene.appearances.get(r.appearance)).collect();
-        let tests = visibility.of(volume, &looks);
-        // Only looks that weigh by the gradient magnitude need each level's largest
-        // (loads compute it then).
-        let magnitudes = looks.iter().any(|a| a.uses_gradient_magnitude());
-        bricked.cache.want_gradients(magnitudes);
-        let (mut drawn, mut empty, mut seen_gradients) = (Vec::new(), Vec::new(), Vec::new());
-        // The coarse level's bricks (always at hand), then the streamed ones present.
-        let coarse = bricked.coarse_bricks.iter().map(|(k, d)| (*k, d.clone()));
-        for (k, data) in coarse.chain(keys.into_iter().filter_map(|(_, k)| bricked.cache.get(k).map(|d| (k, d)))) {
-            if magnitudes {
-                seen_gradients.push((k, data.clone()));
-            }
-            let shows = |(lo, hi): (u16, u16)| tests.as_ref().is_none_or(|t| t.is_empty() || t.iter().any(|f| f(lo, hi)));
-            let mask = if shows(data.range) {
-                data.sub_ranges.iter().enumerate().filter(|(_, r)| shows(**r)).fold(0u64, |m, (i, _)| m | 1 << i)
-            } else {
-                0
-            };
-            if mask == 0 {
-                empty.push((k, data.range.0));
-            } else {
-                drawn.push((k, data, mask));
-            }
-        }
-        let present: std::collections::HashSet<BrickKey> = drawn.iter().map(|(k, ..)| *k).chain(empty.iter().map(|(k, _)| *k)).collect();
-        let resident = want.iter().filter(|k| present.contains(k)).count();
-        let stats = bricked.cache.stats();
-        want_total += want.len();
-        resident_total += resident;
-        pending += stats.pending;
-        failed += stats.failed;
-        for (k, e) in bricked.cache.errors() {
-            warn!("{e} (brick {:?} of level {} of {}; drawn from a coarser level)", k.brick, k.level, dataset.volume.name);
-        }
-        for (k, faults) in bricked.cache.faulted() {
-            warn!("{faults} (brick {:?} of level {} of {})", k.brick, k.level, dataset.volume.name);
-        }
-        // (Written only when a level's largest gradient grew: the component's change
-        // ticks stay quiet otherwise.)
-        if bricked.bypass_change_detection().see_gradients(seen_gradients.iter().map(|(k, d)| (*k, d.as_ref()))) {
-            bricked.set_changed();
-        }
-        volumes[v] = Some(BrickFrame {
-            table_dims: bricked.table_dims(),
-            layout: bricked.cache.layout(),
-            coarse: bricked.coarse,
-            bits,
-            complete: resident == want.len(),
-            gradient_norms: bricked.gradient_norms(),
-            drawn: std::sync::Arc::new(drawn),
-            empty: std::sync::Arc::new(empty),
-        });
+        };
+        total = VolumeCounts {
+            wanted: total.wanted + counts.wanted,
+            resident: total.resident + counts.resident,
+            pending: total.pending + counts.pending,
+            failed: total.failed + counts.failed,
+            finest: counts.finest.into_iter().chain(total.finest).min(),
+        };
+        volumes[v] = Some(frame);
     }
     visibility.keep(scene);
+    last.retain(&regions.datasets);
     status.update(|c| {
         c.bricked = count;
         c.views = frames.len();
-        c.wanted = want_total;
-        c.resident = resident_total;
-        c.pending = pending;
-        c.failed = failed;
-        c.finest_wanted = finest;
+        c.wanted = total.wanted;
+        c.resident = total.resident;
+        c.pending = total.pending;
+        c.failed = total.failed;
+        c.finest_wanted = total.finest;
     });
     out.volumes = volumes;
+}
+
+/// The frame of one bricked volume drawn anew: its wanted bricks asked of its cache, the
+/// resident ones (and their resident ancestors) tested against its looks; with its
+/// counts and the cache's counters once the bricks were asked for.
+fn select_frame(
+    dataset: &Dataset,
+    bricked: &mut Mut<BrickedDataset>,
+    inputs: &Inputs,
+    visibility: &mut VisibilityTests,
+) -> (BrickFrame, VolumeCounts, CacheStats) {
+    let want = wanted(&bricked.levels, bricked.coarse, bricked.cache.layout(), &inputs.seen, &inputs.frames, inputs.cap.max(1));
+    bricked.cache.request(&want);
+    let cache = bricked.cache.stats();
+    // The wanted bricks and their ancestors below the coarse level, coarsest first.
+    let mut keys: BTreeSet<(std::cmp::Reverse<u8>, BrickKey)> = BTreeSet::new();
+    for k in &want {
+        let mut a = *k;
+        while (a.level as usize) < bricked.coarse && keys.insert((std::cmp::Reverse(a.level), a)) {
+            a = a.parent();
+        }
+    }
+    let looks: Vec<&Appearance> = inputs.looks.iter().collect();
+    let tests = visibility.of(&inputs.volume, &looks);
+    // Only looks that weigh by the gradient magnitude need each level's largest
+    // (loads compute it then).
+    let magnitudes = looks.iter().any(|a| a.uses_gradient_magnitude());
+    bricked.cache.want_gradients(magnitudes);
+    let (mut drawn, mut empty, mut seen_gradients) = (Vec::new(), Vec::new(), Vec::new());
+    // The coarse level's bricks (always at hand), then the streamed ones present.
+    let coarse = bricked.coarse_bricks.iter().map(|(k, d)| (*k, d.clone()));
+    for (k, data) in coarse.chain(keys.into_iter().filter_map(|(_, k)| bricked.cache.get(k).map(|d| (k, d)))) {
+        if magnitudes {
+            seen_gradients.push((k, data.clone()));
+        }
+        let shows = |(lo, hi): (u16, u16)| tests.as_ref().is_none_or(|t| t.is_empty() || t.iter().any(|f| f(lo, hi)));
+        let mask = if shows(data.range) {
+            data.sub_ranges.iter().enumerate().filter(|(_, r)| shows(**r)).fold(0u64, |m, (i, _)| m | 1 << i)
+        } else {
+            0
+        };
+        if mask == 0 {
+            empty.push((k, data.range.0));
+        } else {
+            drawn.push((k, data, mask));
+        }
+    }
+    let present: std::collections::HashSet<BrickKey> = drawn.iter().map(|(k, ..)| *k).chain(empty.iter().map(|(k, _)| *k)).collect();
+    let resident = want.iter().filter(|k| present.contains(k)).count();
+    for (k, e) in bricked.cache.errors() {
+        warn!("{e} (brick {:?} of level {} of {}; drawn from a coarser level)", k.brick, k.level, dataset.volume.name);
+    }
+    for (k, faults) in bricked.cache.faulted() {
+        warn!("{faults} (brick {:?} of level {} of {})", k.brick, k.level, dataset.volume.name);
+    }
+    // (Written only when a level's largest gradient grew: the component's change
+    // ticks stay quiet otherwise.)
+    if bricked.bypass_change_detection().see_gradients(seen_gradients.iter().map(|(k, d)| (*k, d.as_ref()))) {
+        bricked.set_changed();
+    }
+    let counts = VolumeCounts {
+        wanted: want.len(),
+        resident,
+        pending: cache.pending,
+        failed: cache.failed,
+        finest: want.iter().map(|k| k.level as usize).min(),
+    };
+    let frame = BrickFrame {
+        table_dims: bricked.table_dims(),
+        layout: bricked.cache.layout(),
+        coarse: bricked.coarse,
+        bits: bricked.bits(),
+        complete: resident == want.len(),
+        gradient_norms: bricked.gradient_norms(),
+        drawn: std::sync::Arc::new(drawn),
+        empty: std::sync::Arc::new(empty),
+    };
+    (frame, counts, cache)
 }

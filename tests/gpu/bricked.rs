@@ -301,3 +301,54 @@ pub fn context_on_bricked_data_normalises_by_the_levels_gradients(gpu: &mut Gpu)
     let memory = gpu.show(ct, look, &camera);
     assert_matches("bricked_context_noisy", &bricked, &memory);
 }
+
+/// A still view of a converged bricked volume keeps its streaming frame and the page
+/// table built from it (`streaming::unchanged`: no selection, no page table each frame),
+/// and draws the same picture; a magnifier then added over the same volume is a change:
+/// its native bricks come and level 0 is drawn under it, and taking it away brings the
+/// first picture back. The head phantom's CT
+/// (256³) streamed from a pyramid in memory (coarse level 2), 3 voxels a pixel: level 1
+/// around the lens, level 0 under it.
+pub fn a_still_bricked_view_keeps_its_frame_until_something_changes(gpu: &mut Gpu) {
+    use focal::streaming::bricked::BrickedScene;
+    let ct = Arc::new(Phantom::Head.generate(256).expect("the head phantom"));
+    let look = Appearance::new(Mode::Dvr, presets::builtin("ct_bone").expect("preset"));
+    let source: Arc<dyn VoxelSource> = Arc::new(focal::volume::source::memory::MemorySource::new(ct.clone(), 32));
+    let centre = ct.grid.center();
+    let voxel = ct.grid.spacing.max_element();
+    let eye = centre + Vec3::new(0.6, -0.7, 0.4).normalize() * 300.0 * voxel;
+    let camera = FocalCamera::look_at(eye, centre, Vec3::Z, FocalProjection::Orthographic { height: 3.0 * SIZE as f32 * voxel });
+    let drawn = |gpu: &mut Gpu| {
+        let scene = gpu.off.world_mut().resource::<BrickedScene>();
+        scene.volumes.iter().flatten().next().map(|f| f.drawn.clone()).expect("a bricked frame")
+    };
+    let still = show_bricked(gpu, &source, &look, &camera, true);
+    let status = gpu.off.world_mut().resource::<StreamStatus>().counts();
+    assert_eq!(status.finest_wanted, Some(1), "{status:?}");
+    let first = drawn(gpu);
+    for _ in 0..3 {
+        gpu.off.update();
+    }
+    assert!(Arc::ptr_eq(&first, &drawn(gpu)), "a still view selected its bricks again");
+    let again = gpu.off.capture().unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(difference(&again, &still).2, 0, "the kept frame drew another picture");
+
+    let lens = Lens::magnifier(Vec2::ZERO, 0.5, 0.2, 4.0);
+    replace_lenses(gpu.off.world_mut(), std::slice::from_ref(&lens));
+    let lensed = gpu.off.capture().unwrap_or_else(|e| panic!("{e}"));
+    assert!(!Arc::ptr_eq(&first, &drawn(gpu)), "the magnifier did not change the frame");
+    assert_eq!(gpu.off.world_mut().resource::<StreamStatus>().counts().finest_wanted, Some(0));
+    replace_lenses(gpu.off.world_mut(), &[]);
+    let without = gpu.off.capture().unwrap_or_else(|e| panic!("{e}"));
+    assert_matches("bricked_lens_taken_away", &without, &still);
+    // Under the lens (0.5 lens units = 16 pixels; 12 kept clear of its border) level 0,
+    // as the magnifier over it in memory draws it, not level 1.
+    replace_lenses(gpu.off.world_mut(), std::slice::from_ref(&lens));
+    let native = gpu.show(level(source.as_ref(), 0), look.clone(), &camera);
+    let blurred = gpu.show(level(source.as_ref(), 1), look.clone(), &camera);
+    replace_lenses(gpu.off.world_mut(), &[]);
+    let (to_native, to_level1) = (mean_within(&lensed, &native, Some(12.0)), mean_within(&lensed, &blurred, Some(12.0)));
+    println!("    under the lens added to the still view: against level 0 mean {to_native:.3}, against level 1 mean {to_level1:.3}");
+    assert!(to_native < 1.0, "under the magnifier added to a still view the image is not level 0's (mean {to_native:.3})");
+    assert!(to_level1 > 2.0 * to_native + 0.3, "level 0 and level 1 do not differ under the lens: the test shows nothing");
+}

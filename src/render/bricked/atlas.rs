@@ -1,4 +1,5 @@
-//! The brick atlas on the GPU and the page buffer, updated every frame.
+//! The brick atlas on the GPU and the page buffer, updated every frame that streaming
+//! hands the renderer new frames.
 //!
 //! One 3D texture of [`Slots`] (8-bit, or 16-bit where a bricked source has 16-bit
 //! codes, in the volume atlas's format so both normalise alike) sized by the GPU
@@ -56,6 +57,34 @@ pub struct BrickAtlas {
     /// Whether every coarse-level brick of this frame's bricked volumes is in the atlas
     /// or empty (each of their samples then reads the atlas).
     pub coarse_in_atlas: bool,
+    /// What the page buffer was last built from, where every drawn brick found its slot.
+    built: Option<Built>,
+}
+
+/// The frames a page buffer was built from: each bricked volume's place in the
+/// directory, its volume and the streaming frame (its bricks' lists held, so that a new
+/// frame's lists cannot take their addresses). Streaming hands the renderer the same
+/// lists while nothing changed (`streaming::unchanged`): the slots, masks and page
+/// tables are then those already on the GPU.
+struct Built(Vec<(usize, Arc<crate::volume::Volume>, BrickFrame)>);
+
+impl Built {
+    fn of(frames: &[(usize, &BrickFrame)], extracted: &ExtractedScene) -> Option<Built> {
+        let volume = |v: usize| extracted.scene.volumes.get(v).cloned();
+        frames.iter().map(|(v, f)| Some((*v, volume(*v)?, (*f).clone()))).collect::<Option<Vec<_>>>().map(Built)
+    }
+
+    fn holds(&self, frames: &[(usize, &BrickFrame)], extracted: &ExtractedScene) -> bool {
+        self.0.len() == frames.len()
+            && self.0.iter().zip(frames).all(|((v, volume, built), (w, frame))| {
+                v == w
+                    && extracted.scene.volumes.get(*w).is_some_and(|x| Arc::ptr_eq(x, volume))
+                    && Arc::ptr_eq(&built.drawn, &frame.drawn)
+                    && Arc::ptr_eq(&built.empty, &frame.empty)
+                    && built.gradient_norms == frame.gradient_norms
+                    && built.table_dims == frame.table_dims
+            })
+    }
 }
 
 impl BrickAtlas {
@@ -108,6 +137,12 @@ pub fn upload_bricks(
         atlas.texture = Some((texture, format));
         atlas.slots = Some(slots);
     }
+    if stale {
+        atlas.built = None;
+    }
+    if atlas.built.as_ref().is_some_and(|b| b.holds(&frames, &extracted)) {
+        return;
+    }
     let (Some((texture, _)), Some(mut slots)) = (atlas.texture.clone(), atlas.slots.take()) else { return };
     slots.next_frame();
     let size = slots.texture_size().as_vec3();
@@ -117,7 +152,7 @@ pub fn upload_bricks(
     let masks_at = dir_at + frames.len();
     words.push(masks_at as u32);
     words.resize(masks_at + 2 * slots.len(), 0);
-    let (mut uploads, mut not_uploaded) = (0usize, 0usize);
+    let (mut uploads, mut not_uploaded, mut not_placed) = (0usize, 0usize, 0usize);
     let mut coarse_in_atlas = true;
     for (i, (v, frame)) in frames.iter().enumerate() {
         let id = extracted.scene.volumes.get(*v).map_or(0, |a| Arc::as_ptr(a) as usize);
@@ -133,6 +168,7 @@ pub fn upload_bricks(
             }
             let Some((s, _)) = slots.place((id, *k)) else {
                 // Every slot holds a brick of this frame: the rest are drawn coarser.
+                not_placed += 1;
                 continue;
             };
             let o = slots.origin(s);
@@ -170,6 +206,7 @@ pub fn upload_bricks(
     });
     atlas.slots = Some(slots);
     atlas.coarse_in_atlas = coarse_in_atlas;
+    atlas.built = if not_uploaded + not_placed == 0 { Built::of(&frames, &extracted) } else { None };
     let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
     if atlas.pages.is_none() || atlas.capacity < bytes.len() as u64 {
         let capacity = (bytes.len() as u64).next_power_of_two().max(256);
