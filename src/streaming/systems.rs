@@ -11,7 +11,7 @@ use glam::Affine3A;
 
 use super::bricked::{BrickFrame, BrickedDataset, BrickedScene, StreamBudget, StreamStatus};
 use super::select::{Magnified, Seen, ViewFrame, wanted};
-use super::unchanged::{Inputs, LastFrames, VolumeCounts};
+use super::unchanged::{Inputs, LastFrames, VolumeCounts, same_looks};
 use crate::dataset::{DataBox, Dataset, SceneRegions, VolumeView};
 use crate::lens::ViewLenses;
 use crate::lens::stack::Effect;
@@ -76,8 +76,7 @@ impl VisibilityTests {
     /// The tests of `looks` on `volume`; `None` where a look may show any code.
     fn of(&mut self, volume: &Arc<Volume>, looks: &[&Appearance]) -> Option<Tests> {
         let key = Arc::as_ptr(volume) as usize;
-        let same = |made: &[Appearance]| made.len() == looks.len() && made.iter().zip(looks).all(|(a, b)| a == *b);
-        if let Some((_, tests)) = self.made.get(&key).filter(|(made, _)| same(made)) {
+        if let Some((_, tests)) = self.made.get(&key).filter(|(made, _)| same_looks(made, looks)) {
             return tests.clone();
         }
         let tests: Option<Vec<CodeVisibility>> = looks.iter().map(|a| a.code_visibility(volume)).collect();
@@ -118,10 +117,10 @@ pub fn stream_bricks(
         let per_brick = bricked.cache.layout().stored().pow(3) as u64 * (bricked.bits() as u64 / 8);
         let cap = budget.gpu_bricks(bricked.bits()).min((budget.cpu_bytes / per_brick.max(1)) as usize) * 3 / 4;
         let inputs = Inputs {
-            volume: volume.clone(),
-            frames: frames.clone(),
+            volume,
+            frames: &frames,
             seen: seen_by(scene, v, volume.grid.world_to_index().inverse()),
-            looks: scene.regions.iter().filter(|r| r.volume == v).filter_map(|r| scene.appearances.get(r.appearance)).cloned().collect(),
+            looks: scene.regions.iter().filter(|r| r.volume == v).filter_map(|r| scene.appearances.get(r.appearance)).collect(),
             cap,
         };
         let (frame, counts) = match last.unchanged(*entity, &inputs, &bricked.cache.stats()) {
@@ -132,13 +131,7 @@ pub fn stream_bricks(
                 (frame, counts)
             }
         };
-        total = VolumeCounts {
-            wanted: total.wanted + counts.wanted,
-            resident: total.resident + counts.resident,
-            pending: total.pending + counts.pending,
-            failed: total.failed + counts.failed,
-            finest: counts.finest.into_iter().chain(total.finest).min(),
-        };
+        total = total.plus(counts);
         volumes[v] = Some(frame);
     }
     visibility.keep(scene);
@@ -164,7 +157,7 @@ fn select_frame(
     inputs: &Inputs,
     visibility: &mut VisibilityTests,
 ) -> (BrickFrame, VolumeCounts, CacheStats) {
-    let want = wanted(&bricked.levels, bricked.coarse, bricked.cache.layout(), &inputs.seen, &inputs.frames, inputs.cap.max(1));
+    let want = wanted(&bricked.levels, bricked.coarse, bricked.cache.layout(), &inputs.seen, inputs.frames, inputs.cap.max(1));
     bricked.cache.request(&want);
     let cache = bricked.cache.stats();
     // The wanted bricks and their ancestors below the coarse level, coarsest first.
@@ -175,11 +168,10 @@ fn select_frame(
             a = a.parent();
         }
     }
-    let looks: Vec<&Appearance> = inputs.looks.iter().collect();
-    let tests = visibility.of(&inputs.volume, &looks);
+    let tests = visibility.of(inputs.volume, &inputs.looks);
     // Only looks that weigh by the gradient magnitude need each level's largest
     // (loads compute it then).
-    let magnitudes = looks.iter().any(|a| a.uses_gradient_magnitude());
+    let magnitudes = inputs.looks.iter().any(|a| a.uses_gradient_magnitude());
     bricked.cache.want_gradients(magnitudes);
     let (mut drawn, mut empty, mut seen_gradients) = (Vec::new(), Vec::new(), Vec::new());
     // The coarse level's bricks (always at hand), then the streamed ones present.

@@ -20,24 +20,45 @@ use crate::region::Appearance;
 use crate::volume::Volume;
 use crate::volume::source::cache::CacheStats;
 
-/// What a bricked volume's selection depends on, apart from its cache.
-pub struct Inputs {
-    pub volume: Arc<Volume>,
-    pub frames: Vec<ViewFrame>,
+/// What a bricked volume's selection depends on this frame, apart from its cache
+/// (borrowed: compared every frame, copied only when a frame is drawn anew).
+pub struct Inputs<'a> {
+    pub volume: &'a Arc<Volume>,
+    pub frames: &'a [ViewFrame],
     pub seen: Vec<Seen>,
-    pub looks: Vec<Appearance>,
+    pub looks: Vec<&'a Appearance>,
     /// The most bricks the selection may want.
     pub cap: usize,
 }
 
-impl PartialEq for Inputs {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.volume, &other.volume)
-            && self.cap == other.cap
-            && self.frames == other.frames
-            && self.seen == other.seen
-            && self.looks == other.looks
+/// [`Inputs`] as a kept frame was drawn from (the volume held, so that no other volume
+/// can take its address).
+struct KeptInputs {
+    volume: Arc<Volume>,
+    frames: Vec<ViewFrame>,
+    seen: Vec<Seen>,
+    looks: Vec<Appearance>,
+    cap: usize,
+}
+
+impl KeptInputs {
+    fn of(inputs: Inputs) -> Self {
+        let Inputs { volume, frames, seen, looks, cap } = inputs;
+        KeptInputs { volume: volume.clone(), frames: frames.to_vec(), seen, looks: looks.into_iter().cloned().collect(), cap }
     }
+
+    fn are(&self, now: &Inputs) -> bool {
+        Arc::ptr_eq(&self.volume, now.volume)
+            && self.cap == now.cap
+            && self.frames == now.frames
+            && self.seen == now.seen
+            && same_looks(&self.looks, &now.looks)
+    }
+}
+
+/// Whether `kept` are the looks `now`, in the same order.
+pub fn same_looks(kept: &[Appearance], now: &[&Appearance]) -> bool {
+    kept.len() == now.len() && kept.iter().zip(now).all(|(a, b)| a == *b)
 }
 
 /// One volume's part of the streaming status.
@@ -50,8 +71,21 @@ pub struct VolumeCounts {
     pub finest: Option<usize>,
 }
 
+impl VolumeCounts {
+    /// The counts of two volumes together.
+    pub fn plus(self, other: VolumeCounts) -> VolumeCounts {
+        VolumeCounts {
+            wanted: self.wanted + other.wanted,
+            resident: self.resident + other.resident,
+            pending: self.pending + other.pending,
+            failed: self.failed + other.failed,
+            finest: self.finest.into_iter().chain(other.finest).min(),
+        }
+    }
+}
+
 struct Kept {
-    inputs: Inputs,
+    inputs: KeptInputs,
     /// The cache's counters once the frame's bricks were asked for, before any was read.
     cache: CacheStats,
     frame: BrickFrame,
@@ -68,13 +102,13 @@ impl LastFrames {
     /// counters: `loaded`, `evicted`, `failed`).
     pub fn unchanged(&self, dataset: Entity, inputs: &Inputs, cache: &CacheStats) -> Option<(BrickFrame, VolumeCounts)> {
         let kept = self.0.get(&dataset)?;
-        (kept.cache.pending == 0 && kept.cache == *cache && kept.inputs == *inputs).then(|| (kept.frame.clone(), kept.counts))
+        (kept.cache.pending == 0 && kept.cache == *cache && kept.inputs.are(inputs)).then(|| (kept.frame.clone(), kept.counts))
     }
 
     /// Keeps the frame just drawn of `dataset`; `cache`: the counters read after its
     /// bricks were asked for and before the resident ones were read.
     pub fn keep(&mut self, dataset: Entity, inputs: Inputs, cache: CacheStats, frame: BrickFrame, counts: VolumeCounts) {
-        self.0.insert(dataset, Kept { inputs, cache, frame, counts });
+        self.0.insert(dataset, Kept { inputs: KeptInputs::of(inputs), cache, frame, counts });
     }
 
     /// Forgets the datasets not among `present`.
@@ -111,8 +145,8 @@ mod tests {
 
     #[test]
     fn a_frame_is_kept_only_while_its_inputs_and_its_cache_are_as_they_were() {
-        let v = volume();
-        let inputs = |cap: usize| Inputs { volume: v.clone(), frames: Vec::new(), seen: Vec::new(), looks: Vec::new(), cap };
+        let (v, w) = (volume(), volume());
+        let inputs = |cap: usize| Inputs { volume: &v, frames: &[], seen: Vec::new(), looks: Vec::new(), cap };
         let cache = CacheStats { resident: 3, loaded: 3, ..Default::default() };
         let kept = frame();
         let counts = VolumeCounts { wanted: 3, resident: 3, ..Default::default() };
@@ -124,7 +158,7 @@ mod tests {
         assert!(Arc::ptr_eq(&same.drawn, &kept.drawn) && c == counts);
         // Another budget, another volume, a brick landed or evicted: drawn anew.
         assert!(last.unchanged(e, &inputs(11), &cache).is_none());
-        let other = Inputs { volume: volume(), ..inputs(10) };
+        let other = Inputs { volume: &w, ..inputs(10) };
         assert!(last.unchanged(e, &other, &cache).is_none(), "the same inputs of another volume");
         assert!(last.unchanged(e, &inputs(10), &CacheStats { loaded: 4, ..cache }).is_none());
         assert!(last.unchanged(e, &inputs(10), &CacheStats { evicted: 1, ..cache }).is_none());
