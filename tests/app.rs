@@ -298,3 +298,59 @@ fn a_moving_view_draws_fewer_pixels_and_refines_at_rest() {
     app.update();
     assert_eq!(resolution(&app), Some(1.0));
 }
+
+/// The first column of the 3D viewport in an app screenshot: right of the panel's
+/// separator line (a grey column between the panel's fill and the black view).
+fn viewport_left(img: &image::RgbaImage) -> Option<u32> {
+    let (w, h) = img.dimensions();
+    let grey = |x: u32, y: u32| {
+        let p = img.get_pixel(x, y);
+        p[0] == p[1] && p[1] == p[2]
+    };
+    (1..w / 2)
+        .find(|&x| {
+            [h / 4, h / 2, 3 * h / 4].iter().all(|&y| {
+                let (before, line, after) = (img.get_pixel(x - 1, y)[0], img.get_pixel(x, y)[0], img.get_pixel(x + 1, y)[0]);
+                grey(x, y) && line > before && line > 40 && after == 0
+            })
+        })
+        .map(|x| x + 1)
+}
+
+#[test]
+fn the_app_shows_what_streaming_does_in_the_viewport_over_a_clean_picture() {
+    let dir = scratch("app-streaming");
+    let scene = dir.join("procedural.ron");
+    // A procedural volume, streamed brick by brick, drawn in blues (no yellow in it).
+    std::fs::write(
+        &scene,
+        r#"(datasets: [(source: Procedural(dims: (256, 256, 256)), appearance: (mode: dvr, transfer: Some((
+                name: "blue crests", space: Absolute, units: None,
+                color: [(40000.0, (0.2, 0.4, 0.9)), (50000.0, (0.6, 0.8, 1.0))],
+                opacity: [(0.0, 0.0), (41000.0, 0.0), (45000.0, 0.25), (52000.0, 0.8)]))))],
+            camera: Orbit(azimuth_deg: 35.0, elevation_deg: 25.0, zoom: 0.9))"#,
+    )
+    .unwrap();
+    let shot = dir.join("app.png");
+    let img = app_screenshot(&scene, 40, &shot);
+    let (w, h) = img.dimensions();
+    let left = viewport_left(&img).unwrap_or_else(|| panic!("no panel beside the viewport in {}", shot.display()));
+    assert!(left > 100 && left < w / 2, "viewport from x = {left} in {}", shot.display());
+    // The status line (grey once every brick it asks for is drawn) sits at the bottom
+    // left of the viewport, 8 points in: none of it over the panel or at the border.
+    let text = |x: u32, y: u32| {
+        let p = img.get_pixel(x, y);
+        p[0] > 110 && p[0].abs_diff(p[1]) < 12 && p[1].abs_diff(p[2]) < 12
+    };
+    let band = h - 40..h;
+    let columns: Vec<u32> = (left..w).filter(|&x| band.clone().any(|y| text(x, y))).collect();
+    assert!(columns.len() > 100, "no status line at the bottom of the viewport in {}", shot.display());
+    assert!((left + 6..left + 20).contains(&columns[0]), "the status line starts at x = {} (viewport from {left})", columns[0]);
+    // Nothing of earlier frames remains: no yellow (the status line while bricks
+    // were still loading) anywhere in the viewport.
+    let stale = (left..w).flat_map(|x| (0..h).map(move |y| (x, y))).filter(|&(x, y)| {
+        let p = img.get_pixel(x, y);
+        p[0] > 150 && p[1] > 150 && p[2] < 90
+    });
+    assert_eq!(stale.count(), 0, "yellow text of earlier frames in {}", shot.display());
+}

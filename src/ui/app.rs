@@ -109,11 +109,17 @@ fn setup(commands: &mut Commands, egui: &mut EguiGlobalSettings) {
     commands.spawn((
         PrimaryEguiContext,
         Camera2d,
+        Msaa::Off,
         RenderLayers::none(),
         Camera {
             order: 1,
             output_mode: CameraOutputMode::Write { blend_state: Some(BlendState::ALPHA_BLENDING), clear_color: ClearColorConfig::None },
-            clear_color: ClearColorConfig::None,
+            // egui draws into this camera's texture, then blended over the 3D view: the
+            // texture starts each frame transparent. (With MSAA, Bevy would load the
+            // texture instead of clearing it, and its texture cache hands the same
+            // textures to both cameras: earlier frames' text and pictures would show
+            // through where no panel paints over them. egui smooths its own edges.)
+            clear_color: ClearColorConfig::Custom(Color::NONE),
             ..default()
         },
     ));

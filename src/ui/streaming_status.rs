@@ -68,7 +68,13 @@ pub fn level_under_cursor(
     }
 }
 
-pub fn streaming_status(mut contexts: EguiContexts, status: Option<Res<StreamStatus>>, under: Option<Res<LevelUnderCursor>>) -> Result {
+pub fn streaming_status(
+    mut contexts: EguiContexts,
+    status: Option<Res<StreamStatus>>,
+    under: Option<Res<LevelUnderCursor>>,
+    windows: Query<&Window, With<PrimaryWindow>>,
+    cams: Query<&Camera, With<MainCamera>>,
+) -> Result {
     let Some(status) = status else { return Ok(()) };
     let c = status.counts();
     if c.bricked == 0 {
@@ -93,12 +99,22 @@ pub fn streaming_status(mut contexts: EguiContexts, status: Option<Res<StreamSta
         text += &format!(", level {l} under the cursor");
     }
     let color = if converged { egui::Color32::GRAY } else { egui::Color32::YELLOW };
-    let rect = ctx.viewport_rect();
+    // The 3D viewport (beside the panels), in egui points.
+    let rect = match (windows.single(), cams.single()) {
+        (Ok(window), Ok(camera)) => {
+            let (origin, size) = viewport_logical(camera, window);
+            egui::Rect::from_min_size(egui::pos2(origin.x, origin.y), egui::vec2(size.x, size.y))
+        }
+        _ => ctx.viewport_rect(),
+    };
+    let margin = 8.0;
     egui::Area::new("streaming status".into())
-        .anchor(egui::Align2::LEFT_BOTTOM, egui::vec2(8.0, -8.0))
+        .pivot(egui::Align2::LEFT_BOTTOM)
+        .fixed_pos(rect.left_bottom() + egui::vec2(margin, -margin))
         .interactable(false)
         .constrain_to(rect)
         .show(&ctx, |ui| {
+            ui.set_max_width((rect.width() - 2.0 * margin).max(1.0));
             ui.label(egui::RichText::new(text).color(color).small().monospace());
         });
     Ok(())
