@@ -3,7 +3,8 @@
 //! give; pyramids `focal convert` writes are checked by zarr-python, nibabel and numpy
 //! (tests/oracle/); chunks that are corrupt, absent or truncated, metadata that is wrong
 //! and HTTP faults (a loopback server: 404, 500, a dropped connection) give messages
-//! naming them and a picture of the rest.
+//! naming them and a picture of the rest; streamed, a source fetches and decodes each
+//! chunk once for the boxes that share it.
 //!
 //! The oracle runs in `$FOCAL_ORACLE_PYTHON` (scripts/test.sh provides one with zarr,
 //! numpy and nibabel), else in a `python3` that has them; with neither the tests say so
@@ -378,4 +379,58 @@ fn pyramids_over_http_read_like_files_and_faults_are_named() {
     let err = ome_zarr::open(Path::new(&format!("{}/nothing.ome.zarr", server.url))).map(|_| ()).expect_err("refused").to_string();
     assert!(err.contains("nothing.ome.zarr"), "{err}");
     assert!(start.elapsed() < std::time::Duration::from_secs(60), "HTTP faults took {:?}", start.elapsed());
+}
+
+/// Boxes of 10³ every 6 voxels over level 0 (clipped to it): neighbours share chunks,
+/// as streamed bricks and their aprons do.
+fn overlapping_boxes(dims: UVec3) -> Vec<(UVec3, UVec3)> {
+    let starts = |n: u32| (0..n).step_by(6).collect::<Vec<u32>>();
+    let mut out = Vec::new();
+    for z in starts(dims.z) {
+        for y in starts(dims.y) {
+            for x in starts(dims.x) {
+                let lo = UVec3::new(x, y, z);
+                out.push((lo, (dims - lo).min(UVec3::splat(10))));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn a_streamed_source_fetches_each_chunk_once_and_reads_as_without() {
+    let Some(dir) = fixtures() else { return };
+    let server = server::Server::start(dir.clone());
+    // Zarr v2 (a chunk a file) and v3 sharded (inner chunks by byte ranges).
+    for name in ["v2_uint16.ome.zarr", "v3_float32_sharded.ome.zarr"] {
+        let url = format!("{}/{name}", server.url);
+        let plain = ome_zarr::open(Path::new(&url)).expect("opens over HTTP");
+        let kept = ome_zarr::open(Path::new(&url)).expect("opens over HTTP");
+        assert_eq!(kept.keep_decoded(8 << 20), 8 << 20);
+        let boxes = overlapping_boxes(plain.info().levels[0].grid.dims);
+        let before = server.requests();
+        let read_plain: Vec<_> = boxes.iter().map(|&(lo, size)| plain.read_box(0, lo, size).expect("box")).collect();
+        let (between, read_kept): (usize, Vec<_>) =
+            (server.requests(), boxes.iter().map(|&(lo, size)| kept.read_box(0, lo, size).expect("box")).collect());
+        let (without, with) = (between - before, server.requests() - between);
+        assert_eq!(read_kept, read_plain, "{name}: the same voxels and faults");
+        // Every box touches up to 8 chunks of 8³ shared with its neighbours: without
+        // keeping them, each is fetched again for every box.
+        assert!(with * 3 < without, "{name}: {with} requests kept, {without} without ({} boxes)", boxes.len());
+    }
+    // A chunk that could not be read is not kept: the next box tries it again, and its
+    // fault is named for every box that touches it.
+    let url = format!("{}/v2_uint16.ome.zarr", server.url);
+    let s = ome_zarr::open(Path::new(&url)).expect("opens");
+    s.keep_decoded(8 << 20);
+    server.inject("v2_uint16.ome.zarr/0/0/0/1", Fault::Status(500));
+    let unreadable = |b: &focal::volume::source::Block| b.faults.iter().filter(|f| f.kind == FaultKind::Unreadable).count();
+    let first = s.read_box(0, UVec3::ZERO, UVec3::new(16, 8, 8)).expect("box");
+    let again = s.read_box(0, UVec3::new(4, 0, 0), UVec3::new(12, 8, 8)).expect("box");
+    assert_eq!((unreadable(&first), unreadable(&again)), (1, 1), "{:?}", again.faults);
+    server.heal("v2_uint16.ome.zarr/0/0/0/1");
+    let healed = s.read_box(0, UVec3::ZERO, UVec3::new(16, 8, 8)).expect("box");
+    assert_eq!(unreadable(&healed), 0, "{:?}", healed.faults);
+    // 7x + 13y at (9, 1, 0), in the chunk that failed before.
+    assert_eq!(healed.voxels.code(9 + 16), 76);
 }

@@ -119,6 +119,10 @@ impl BrickedDataset {
             .find(|&k| info.levels[k].grid.voxel_count() as u64 <= COARSE_VOXELS)
             .unwrap_or(info.levels.len() - 1)
             .max(1);
+        // An eighth of the memory budget for the source's decoded chunks (a brick's box
+        // and its apron touch up to eight of them, each shared with the bricks beside
+        // it), the rest for the bricks.
+        let kept = source.keep_decoded(cpu_bytes / 8);
         let (mut volume, faults) = read_level(source.as_ref(), coarse, &|_| {}).map_err(|e| e.to_string())?;
         // A coarse level's means span less than the data, and a look's table covers the
         // dataset's range (values past it take its edge): the source's own range where it
@@ -138,7 +142,7 @@ impl BrickedDataset {
         }
         let levels = info.levels.clone();
         let coarse_bricks = Arc::new(bricks_of(&volume, coarse).map_err(|e| e.to_string())?);
-        let cache = Arc::new(BrickCache::new(source, BRICK, cpu_bytes));
+        let cache = Arc::new(BrickCache::new(source, BRICK, cpu_bytes.saturating_sub(kept)));
         let gradient_max = vec![0.0; coarse + 1];
         Ok(Ok((BrickedDataset { cache, levels, coarse, coarse_bricks, gradient_max }, volume)))
     }

@@ -1,12 +1,13 @@
 //! A small HTTP/1.1 file server on the loopback address for the OME-Zarr tests: GET and
 //! HEAD of the files under a folder (every response closes its connection), with faults
 //! injected per path: a status code instead of the file, or the connection dropped
-//! without an answer.
+//! without an answer. It counts the requests it gets.
 
 use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Write};
 use std::net::{TcpListener, TcpStream};
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// What the server does instead of serving a path.
@@ -20,6 +21,7 @@ pub struct Server {
     /// `http://127.0.0.1:PORT`.
     pub url: String,
     faults: Arc<Mutex<HashMap<String, Fault>>>,
+    requests: Arc<AtomicUsize>,
 }
 
 impl Server {
@@ -28,14 +30,26 @@ impl Server {
         let listener = TcpListener::bind("127.0.0.1:0").expect("a loopback port");
         let url = format!("http://{}", listener.local_addr().expect("address"));
         let faults: Arc<Mutex<HashMap<String, Fault>>> = Arc::default();
-        let shared = faults.clone();
+        let requests: Arc<AtomicUsize> = Arc::default();
+        let (shared, counted) = (faults.clone(), requests.clone());
         std::thread::spawn(move || {
             for stream in listener.incoming().flatten() {
+                counted.fetch_add(1, Ordering::SeqCst);
                 let (root, faults) = (root.clone(), shared.clone());
                 std::thread::spawn(move || answer(stream, &root, &faults));
             }
         });
-        Server { url, faults }
+        Server { url, faults, requests }
+    }
+
+    /// From now on `path` is served again.
+    pub fn heal(&self, path: &str) {
+        self.faults.lock().unwrap_or_else(|p| p.into_inner()).remove(&format!("/{path}"));
+    }
+
+    /// Requests (connections: every response closes its own) so far.
+    pub fn requests(&self) -> usize {
+        self.requests.load(Ordering::SeqCst)
     }
 
     /// From now on `path` (from the root, `a/b/c`) answers with `fault`.

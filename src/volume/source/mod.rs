@@ -136,6 +136,14 @@ pub trait VoxelSource: Send + Sync {
 
     /// The codes of voxels `lo .. lo + size` of `level`, which must lie inside it.
     fn read_box(&self, level: usize, lo: UVec3, size: UVec3) -> Result<Block, SourceError>;
+
+    /// Lets the source keep up to `bytes` of what it decoded for later reads (the
+    /// chunks a box shares with the boxes beside it) and returns how many it may keep,
+    /// which the caller takes from its own memory budget. A source that decodes nothing
+    /// keeps nothing (the default).
+    fn keep_decoded(&self, _bytes: u64) -> u64 {
+        0
+    }
 }
 
 /// Checks that a box lies inside a level of `info` (the common guard of every source).

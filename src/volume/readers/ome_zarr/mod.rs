@@ -6,6 +6,7 @@
 //! [`WHOLE_LEVEL_BYTES`] (and the reader limits), for the paths that need a volume in
 //! memory. Metadata is parsed by [`metadata`].
 
+mod chunks;
 pub mod metadata;
 pub mod source;
 

@@ -11,8 +11,12 @@
 //! are decoded). A chunk the store does not have is the array's fill value, as Zarr
 //! defines, and is reported as absent; a chunk that fails to read or decode is drawn at
 //! the fill value too and reported with its key and the error.
+//!
+//! Streamed, the source keeps the chunks it decoded for the next boxes that touch them
+//! (`chunks`, within the share of the memory budget the streaming gives it).
 
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::{DMat3, DVec3, UVec3};
 use zarrs::array::data_type::{
@@ -21,6 +25,7 @@ use zarrs::array::data_type::{
 use zarrs::array::{Array, ArrayShardedExt, ArraySubset, ElementOwned};
 use zarrs::storage::ReadableStorage;
 
+use super::chunks::{ChunkCache, Decoded};
 use super::metadata::{AxisKind, Multiscale};
 use crate::volume::grid::{Grid, fmt_dims};
 use crate::volume::source::{Block, Fault, FaultKind, SourceError, SourceInfo, SourceLevel, VoxelSource, check_box};
@@ -69,6 +74,7 @@ pub struct ZarrSource {
     info: SourceInfo,
     levels: Vec<Level>,
     encoding: Encoding,
+    chunks: ChunkCache,
 }
 
 impl ZarrSource {
@@ -181,7 +187,7 @@ impl ZarrSource {
             warnings,
             range: meta.window,
         };
-        let mut source = ZarrSource { info: info.clone(), levels, encoding: Encoding::U16 };
+        let mut source = ZarrSource { info: info.clone(), levels, encoding: Encoding::U16, chunks: ChunkCache::default() };
         let (encoding, values, bits) = source.encoding_for(&data_type, meta.window, &mut info.warnings)?;
         info.values = values;
         info.bits = bits;
@@ -371,47 +377,81 @@ impl VoxelSource for ZarrSource {
     fn read_box(&self, level: usize, lo: UVec3, size: UVec3) -> Result<Block, SourceError> {
         check_box(&self.info, level, lo, size)?;
         let l = &self.levels[level];
+        let dims = self.info.levels[level].grid.dims;
         let n = size.x as usize * size.y as usize * size.z as usize;
         let mut codes = vec![self.fill_code(l); n];
         let mut faults = Vec::new();
         // The read chunks the box touches, along x, y, z.
         let chunk = |axis: usize| l.spatial[axis].map_or(1, |d| l.read_chunk[d]);
         let range = |axis: usize| (lo[axis] as u64 / chunk(axis))..=((lo[axis] + size[axis] - 1) as u64 / chunk(axis));
-        let store = l.array.storage();
+        let keep = self.chunks.keeps();
         for cz in range(2) {
             for cy in range(1) {
                 for cx in range(0) {
                     let c = [cx, cy, cz];
-                    let clo = UVec3::from_array([0, 1, 2].map(|a| ((c[a] * chunk(a)) as u32).max(lo[a])));
-                    let chi = UVec3::from_array([0, 1, 2].map(|a| (((c[a] + 1) * chunk(a)) as u32).min(lo[a] + size[a])));
-                    let part = l.subset(clo, chi - clo);
-                    // The storage chunk (a whole shard when sharded) holding this part.
-                    let key = l.storage_chunk(&part).map(|idx| l.array.chunk_key(&idx));
-                    let key_name = key.as_ref().map_or_else(|| format!("{part}"), |k| k.to_string());
-                    if let Some(k) = &key
-                        && matches!(store.size_key(k), Ok(None))
-                    {
-                        faults.push(Fault {
-                            chunk: key_name.clone(),
-                            kind: FaultKind::Absent,
-                            problem: "absent from the store: drawn at the fill value".into(),
-                        });
-                    }
-                    let targets = l.targets(clo, chi - clo, lo, size);
-                    match self.read_part(l, &part, &targets, &mut codes) {
-                        Ok(0) => {}
-                        Ok(n) => faults.push(Fault {
-                            chunk: key_name,
-                            kind: FaultKind::NotFinite,
-                            problem: format!("{n} samples NaN or infinite: drawn at the window's low end"),
-                        }),
-                        Err(e) => faults.push(Fault { chunk: key_name, kind: FaultKind::Unreadable, problem: e }),
-                    }
+                    let chunk_lo = UVec3::from_array([0, 1, 2].map(|a| (c[a] * chunk(a)) as u32));
+                    let chunk_hi = UVec3::from_array([0, 1, 2].map(|a| (((c[a] + 1) * chunk(a)) as u32).min(dims[a])));
+                    let part = if keep {
+                        // The whole chunk, kept for the boxes beside this one.
+                        let id = (level, c);
+                        self.chunks.get(id).unwrap_or_else(|| {
+                            let decoded = Arc::new(self.decode(l, chunk_lo, chunk_hi - chunk_lo));
+                            if decoded.faults.iter().all(|f| f.kind != FaultKind::Unreadable) {
+                                self.chunks.insert(id, decoded.clone());
+                            }
+                            decoded
+                        })
+                    } else {
+                        // Only what the box takes of it.
+                        let (a, b) = (chunk_lo.max(lo), chunk_hi.min(lo + size));
+                        Arc::new(self.decode(l, a, b - a))
+                    };
+                    part.copy_into(lo, size, &mut codes);
+                    faults.extend(part.faults.iter().cloned());
                 }
             }
         }
         let voxels = if self.info.bits == 8 { Voxels::U8(codes.into_iter().map(|c| c as u8).collect()) } else { Voxels::U16(codes) };
         Ok(Block { voxels, faults })
+    }
+
+    fn keep_decoded(&self, bytes: u64) -> u64 {
+        self.chunks.set_budget(bytes);
+        bytes
+    }
+}
+
+impl ZarrSource {
+    /// The box `lo .. lo + size` of level `l`, which lies in one read chunk, decoded to
+    /// codes (the fill value's where it could not be read), with what was wrong.
+    fn decode(&self, l: &Level, lo: UVec3, size: UVec3) -> Decoded {
+        let n = size.x as usize * size.y as usize * size.z as usize;
+        let mut codes = vec![self.fill_code(l); n];
+        let mut faults = Vec::new();
+        let part = l.subset(lo, size);
+        // The storage chunk (a whole shard when sharded) holding this part.
+        let key = l.storage_chunk(&part).map(|idx| l.array.chunk_key(&idx));
+        let key_name = key.as_ref().map_or_else(|| format!("{part}"), |k| k.to_string());
+        if let Some(k) = &key
+            && matches!(l.array.storage().size_key(k), Ok(None))
+        {
+            faults.push(Fault {
+                chunk: key_name.clone(),
+                kind: FaultKind::Absent,
+                problem: "absent from the store: drawn at the fill value".into(),
+            });
+        }
+        let targets = l.targets(lo, size, lo, size);
+        match self.read_part(l, &part, &targets, &mut codes) {
+            Ok(0) => {}
+            Ok(n) => faults.push(Fault {
+                chunk: key_name,
+                kind: FaultKind::NotFinite,
+                problem: format!("{n} samples NaN or infinite: drawn at the window's low end"),
+            }),
+            Err(e) => faults.push(Fault { chunk: key_name, kind: FaultKind::Unreadable, problem: e }),
+        }
+        Decoded { lo, size, codes, faults }
     }
 }
 
