@@ -24,7 +24,8 @@ struct Args {
     /// (Automation) In the app, save a screenshot to this path after --frames frames, then quit.
     #[arg(long, requires = "frames")]
     screenshot: Option<PathBuf>,
-    /// (Automation) Frames to draw before the screenshot.
+    /// (Automation) Frames to draw before the screenshot, counted once the data is loaded
+    /// and drawn (and, when streamed, has converged).
     #[arg(long)]
     frames: Option<u32>,
     /// Window size WIDTHxHEIGHT.

@@ -332,9 +332,8 @@ fn the_app_shows_what_streaming_does_in_the_viewport_over_a_clean_picture() {
     )
     .unwrap();
     let shot = dir.join("app.png");
-    // (60 frames: enough for its 512 bricks to arrive and the line to turn grey on a
-    // loaded machine.)
-    let img = app_screenshot(&scene, 60, &shot);
+    // (The shot waits for the streamed picture to converge, then 10 frames.)
+    let img = app_screenshot(&scene, 10, &shot);
     let (w, h) = img.dimensions();
     let left = viewport_left(&img).unwrap_or_else(|| panic!("no panel beside the viewport in {}", shot.display()));
     assert!(left > 100 && left < w / 2, "viewport from x = {left} in {}", shot.display());

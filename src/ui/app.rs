@@ -301,19 +301,30 @@ fn sync_view(state: Res<AppState>, mut cams: Query<(&mut Camera, &mut VolumeView
 }
 
 /// Test automation: a screenshot after N frames (counted once loading is done, the ray
-/// caster has drawn the volumes and no pipeline is still compiling, so the shot never shows a half-built first frame),
-/// then exit as soon as it is written.
+/// caster has drawn the volumes, no pipeline is still compiling and streamed volumes
+/// have converged, as the headless render waits for them, at most
+/// [`crate::render::headless::STREAM_WAIT`]: so the shot never shows a half-built
+/// picture), then exit as soon as it is written.
 fn automation(
     mut state: ResMut<AppState>,
     mut commands: Commands,
     mut exit: MessageWriter<AppExit>,
     loading: Query<(), With<loading::Loading>>,
     progress: Option<Res<crate::render::RenderProgress>>,
+    stream: Option<Res<crate::streaming::bricked::StreamStatus>>,
+    mut streaming_since: Local<Option<std::time::Instant>>,
 ) {
     let Some((after, path)) = state.screenshot_and_exit.clone() else { return };
     let settled = progress.is_some_and(|p| p.volumes_drawn() > 0 && p.pipelines_settled());
     if !loading.is_empty() || !settled {
         return;
+    }
+    if state.frames == 0 && !stream.is_none_or(|s| s.converged()) {
+        let since = *streaming_since.get_or_insert_with(std::time::Instant::now);
+        if since.elapsed() < crate::render::headless::STREAM_WAIT {
+            return;
+        }
+        warn!("streaming did not converge within {:?}: the screenshot shows what had arrived", crate::render::headless::STREAM_WAIT);
     }
     state.frames += 1;
     if state.frames == after {
