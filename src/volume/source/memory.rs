@@ -63,20 +63,36 @@ impl VoxelSource for MemorySource {
 
 /// The box `lo .. lo + size` of voxels `src` (`dims`), which must hold it.
 pub fn copy_box(src: &Voxels, dims: UVec3, lo: UVec3, size: UVec3) -> Voxels {
-    fn copy<T: Copy>(v: &[T], dims: UVec3, lo: UVec3, size: UVec3) -> Vec<T> {
-        let (nx, ny) = (dims.x as usize, dims.y as usize);
-        let mut out = Vec::with_capacity(size.x as usize * size.y as usize * size.z as usize);
-        for z in lo.z..lo.z + size.z {
-            for y in lo.y..lo.y + size.y {
-                let row = (z as usize * ny + y as usize) * nx + lo.x as usize;
-                out.extend_from_slice(&v[row..row + size.x as usize]);
-            }
-        }
+    fn copy<T: Copy + Default>(v: &[T], dims: UVec3, lo: UVec3, size: UVec3) -> Vec<T> {
+        let mut out = vec![T::default(); size.x as usize * size.y as usize * size.z as usize];
+        copy_overlap((v, UVec3::ZERO, dims), (&mut out, lo, size));
         out
     }
     match src {
         Voxels::U8(v) => Voxels::U8(copy(v, dims, lo, size)),
         Voxels::U16(v) => Voxels::U16(copy(v, dims, lo, size)),
+    }
+}
+
+/// Copies the voxels two boxes of one level share from the first into the second: each
+/// given as its values (x fastest), its first voxel and its size.
+pub fn copy_overlap<T: Copy>((src, src_lo, src_size): (&[T], UVec3, UVec3), (dst, lo, size): (&mut [T], UVec3, UVec3)) {
+    let a = src_lo.max(lo);
+    let b = (src_lo + src_size).min(lo + size);
+    if a.cmpge(b).any() {
+        return;
+    }
+    let run = (b.x - a.x) as usize;
+    let index = |p: UVec3, origin: UVec3, dims: UVec3| {
+        let d = p - origin;
+        (d.z as usize * dims.y as usize + d.y as usize) * dims.x as usize + d.x as usize
+    };
+    for z in a.z..b.z {
+        for y in a.y..b.y {
+            let row = UVec3::new(a.x, y, z);
+            let (from, to) = (index(row, src_lo, src_size), index(row, lo, size));
+            dst[to..to + run].copy_from_slice(&src[from..from + run]);
+        }
     }
 }
 

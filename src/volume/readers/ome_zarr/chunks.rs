@@ -7,7 +7,9 @@
 //! and, for the small parts the aprons take, at 64³ voxels decoded for a few thousand
 //! used. Kept decoded (as codes, with what was wrong with them), a chunk is fetched
 //! and decoded once while its neighbours' bricks come in. A chunk that could not be
-//! read is not kept, so a later read tries again (an HTTP error may pass).
+//! read is not kept, so a later read tries again (an HTTP error may pass). Two loader
+//! threads that miss the same chunk at once both decode it (the second copy replaces
+//! the first): rare with the loader's few threads, and no thread waits for another.
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -15,6 +17,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use glam::UVec3;
 
 use crate::volume::source::Fault;
+use crate::volume::source::memory::copy_overlap;
 
 /// A chunk: its level and its index along x, y, z.
 pub type ChunkId = (usize, [u64; 3]);
@@ -36,21 +39,7 @@ impl Decoded {
     /// Copies the voxels it shares with the box `lo .. lo + size` into `out` (that box's
     /// codes, x fastest).
     pub fn copy_into(&self, lo: UVec3, size: UVec3, out: &mut [u16]) {
-        let a = self.lo.max(lo);
-        let b = (self.lo + self.size).min(lo + size);
-        if a.cmpge(b).any() {
-            return;
-        }
-        let run = (b.x - a.x) as usize;
-        let (sx, sy) = (self.size.x as usize, self.size.y as usize);
-        let (ox, oy) = (size.x as usize, size.y as usize);
-        for z in a.z..b.z {
-            for y in a.y..b.y {
-                let from = ((z - self.lo.z) as usize * sy + (y - self.lo.y) as usize) * sx + (a.x - self.lo.x) as usize;
-                let to = ((z - lo.z) as usize * oy + (y - lo.y) as usize) * ox + (a.x - lo.x) as usize;
-                out[to..to + run].copy_from_slice(&self.codes[from..from + run]);
-            }
-        }
+        copy_overlap((&self.codes, self.lo, self.size), (out, lo, size));
     }
 }
 
