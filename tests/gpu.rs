@@ -369,7 +369,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 35] = [
+    let tests: [GpuTest; 36] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -398,6 +398,7 @@ fn main() {
         ("overlapping_two_level_regions_match_the_reference", twolevel::overlapping_two_level_regions_match_the_reference),
         ("the_rest_draws_no_rim_beside_a_hidden_object", twolevel::the_rest_draws_no_rim_beside_a_hidden_object),
         ("a_clip_window_shows_nothing_of_the_main_view_inside", windows::a_clip_window_shows_nothing_of_the_main_view_inside),
+        ("clip_windows_drawn_in_place_match_the_reference", windows::clip_windows_drawn_in_place_match_the_reference),
         ("a_magnifying_window_enlarges_its_source", windows::a_magnifying_window_enlarges_its_source),
         ("an_exploded_head_matches_the_reference", explode::an_exploded_head_matches_the_reference),
         ("eighteen_exploded_parts_match_the_reference", explode::eighteen_exploded_parts_match_the_reference),

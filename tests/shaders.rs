@@ -17,7 +17,7 @@ struct View {
 const BEVY_FULLSCREEN: &str = "#define_import_path bevy_core_pipeline::fullscreen_vertex_shader
 struct FullscreenVertexOutput { @builtin(position) position: vec4<f32>, @location(0) uv: vec2<f32> }";
 
-const MODULES: [&str; 16] = [
+const MODULES: [&str; 17] = [
     "types",
     "bindings",
     "camera",
@@ -34,6 +34,7 @@ const MODULES: [&str; 16] = [
     "samples",
     "segments",
     "two_level",
+    "insets",
 ];
 
 fn read(rel: &str) -> String {
@@ -53,7 +54,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 19] = [
+const DEFS: [&str; 21] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -73,6 +74,8 @@ const DEFS: [&str; 19] = [
     "HAS_BRICKED",
     "BRICKED_ONLY",
     "OWN_VALUES",
+    "INSETS",
+    "MANY_INSETS",
 ];
 
 #[test]
@@ -109,6 +112,18 @@ fn every_shader_variant_composes_and_validates() {
         possible(bits)
             && (bits & own == 0
                 || (bits & bit("HAS_TWO_LEVEL") != 0 && ((bits & !own).count_ones() <= 3 || (bits | bricked | bit("HAS_HOLES")) == full)))
+    };
+    // Windows drawn in place touch the DVR loop alone: with DVR and up to two other
+    // defs (one with four slots), and with all of them.
+    let insets = bit("INSETS") | bit("MANY_INSETS");
+    let possible = |bits: u32| {
+        let others = (bits & !insets & !bit("HAS_DVR")).count_ones();
+        let most = if bits & bit("MANY_INSETS") != 0 { 1 } else { 2 };
+        possible(bits)
+            && (bits & insets == 0
+                || (needs("MANY_INSETS", "INSETS", bits)
+                    && needs("INSETS", "HAS_DVR", bits)
+                    && (others <= most || bits == full & !bit("HAS_HOLES"))))
     };
     let variants: Vec<u32> = (0u32..(1 << DEFS.len())).filter(|b| possible(*b)).collect();
     // (On every core: the variants are independent, and one after another they were

@@ -10,7 +10,7 @@
 #import focal::camera::Ray
 #import focal::regions::to_voxel
 #import focal::sampling::{trilinear, trilinear_at, trilinear_with_doi, nearest_code, index_gradient, index_gradient_at, gradient_norm, count_sample}
-#import focal::transfer::{classify, classify_label, classify_lambda, correct_opacity, filtered_table}
+#import focal::transfer::{classify, classify_label, classify_lambda, correct_opacity, filtered, filtered_table}
 #import focal::shading::{shade, shade_with, blinn_phong}
 #import focal::context::{context_opacity, eye_distance}
 #import focal::compositing::composite
@@ -68,12 +68,14 @@ fn adds_something(c: Classified) -> bool {
 
 // The first half of dvr_sample: the sample at q classified.
 fn dvr_classify(r: Region, q: vec3<f32>) -> Classified {
-    return dvr_classify_at(r, q, false);
+    return dvr_classify_at(r, q, false, r.lut_offset);
 }
 
 // dvr_classify where `located` (a literal) says the last page look-up's answer holds for
-// q (sampling::trilinear_at; labels and the degree-of-interest channel look up anyway).
-fn dvr_classify_at(r: Region, q: vec3<f32>, located: bool) -> Classified {
+// q (sampling::trilinear_at; labels and the degree-of-interest channel look up anyway),
+// with the transfer function's table at `lut` (r's own, or a window's drawn in place:
+// focal::insets).
+fn dvr_classify_at(r: Region, q: vec3<f32>, located: bool, lut: u32) -> Classified {
     count_sample();
     var rgba: vec4<f32>;
     var v = 0.0;
@@ -87,11 +89,11 @@ fn dvr_classify_at(r: Region, q: vec3<f32>, located: bool) -> Classified {
         rgba = classify_label(r, nearest_code(r, q), scene.lut_atlas_width);
     } else {
         v = value_at(r, q, vd, located);
-        rgba = classify(r, v, scene.lut_atlas_width);
+        rgba = filtered(r, lut, v, scene.lut_atlas_width);
     }
 #else
     v = value_at(r, q, vd, located);
-    rgba = classify(r, v, scene.lut_atlas_width);
+    rgba = filtered(r, lut, v, scene.lut_atlas_width);
 #endif
     var w = 1.0;
 #ifdef HAS_SELECTION

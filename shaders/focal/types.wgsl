@@ -112,6 +112,8 @@ const REGION_KEEP_UNSELECTED: u32 = 32u;
 const REGION_COMPANION: u32 = 64u;
 // A segmented region whose labels lie on its data's grid (two_level::own_value).
 const REGION_ON_GRID: u32 = 128u;
+// Clip windows are drawn in this region's samples (records + 1: objects; focal::insets).
+const REGION_INSETS: u32 = 512u;
 
 const VIEW_JITTER: u32 = 1u;
 const VIEW_SKIP_EMPTY: u32 = 2u;

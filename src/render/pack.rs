@@ -19,7 +19,7 @@ use crate::volume::pyramid::{MIP_LEVELS, half_dims};
 use super::gpu_types::{CLUSTER, GpuRegion, context_power, mode, region_flags};
 use crate::context::Power;
 use crate::reference::prepare::{PreparedLookup, PreparedRegion};
-use crate::region::{Mode, RenderScene, meet};
+use crate::region::{Mode, Plane, RenderScene, meet};
 
 /// Dimensions of a volume's boxes in the atlas: the volume, then (with `mips`) its levels.
 fn volume_boxes(dims: UVec3, mips: bool) -> Vec<UVec3> {
@@ -108,8 +108,10 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
     out.doi_channels = out.volumes.iter().map(|&v| channels.as_ref().and_then(|c| c[v])).collect();
     let slot_of = |out: &PackedScene, v: usize| out.volumes.iter().position(|&u| u == v);
     let fused = companions(&prepared, channels.is_some());
+    let in_place = insets(&prepared);
+    let holes = kept_holes(&prepared, &in_place);
     let mut drawn_in = vec![false; prepared.len()];
-    for b in fused.iter().flatten() {
+    for b in fused.iter().flatten().chain(in_place.iter().map(|i| &i.window)) {
         drawn_in[*b] = true;
     }
     let mut segmented = Vec::new();
@@ -128,7 +130,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         let Some(slots) = slots else { continue };
         slots_of[i] = Some(out.regions.len() as u32);
         let levels = out.levels[slots[0]].clone();
-        let mut region = pack_region(p, &levels, out.brick_atlas.offsets[slots[0]], &mut out);
+        let mut region = pack_region(p, &holes[i], &levels, out.brick_atlas.offsets[slots[0]], &mut out);
         if let Some(objects) = &p.objects {
             region.mode = mode::TWO_LEVEL;
             if objects.on_grid {
@@ -159,6 +161,12 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
             draw_in(&mut out, a, record as usize);
         }
     }
+    for (k, inset) in in_place.iter().enumerate() {
+        let slot = in_place[..k].iter().filter(|i| i.host == inset.host).count();
+        if let (Some(host), Some(window)) = (out.region_slots[inset.host], out.region_slots[inset.window]) {
+            draw_in_place(&mut out, host as usize, slot, window as usize);
+        }
+    }
     // Records the ray does not traverse: the parts and labels of segmented regions, the
     // selections of weighted ones.
     for (index, p, slots) in segmented {
@@ -174,6 +182,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
     if fused.iter().any(Option::is_some) {
         out.features |= super::gpu_types::features::COMPANION;
     }
+    out.features |= inset_features(&out.regions);
     if channels.is_some() && out.features & super::gpu_types::features::SELECTION != 0 {
         out.features |= super::gpu_types::features::DOI_CHANNEL;
     }
@@ -204,7 +213,7 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
     let first = out.regions.len() as u32;
     let data_levels = out.levels[slots[0]].clone();
     for (k, part) in objects.parts.iter().enumerate() {
-        let mut r = pack_region(part, &data_levels, out.brick_atlas.offsets[slots[0]], out);
+        let mut r = pack_region(part, &part.region.holes, &data_levels, out.brick_atlas.offsets[slots[0]], out);
         (r.value_lo, r.value_hi) = objects.table.ranges.get(k).copied().unwrap_or((f32::NEG_INFINITY, f32::INFINITY));
         // Infinities do not survive every path to the GPU: the largest finite floats.
         (r.value_lo, r.value_hi) = (r.value_lo.max(f32::MIN), r.value_hi.min(f32::MAX));
@@ -404,11 +413,12 @@ pub fn reads_mips(r: &GpuRegion) -> bool {
 }
 
 /// Packs one region; `levels` are the atlas offsets of its volume and mip levels.
-fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &mut PackedScene) -> GpuRegion {
+/// `holes`: the region's holes left after [`insets`] took theirs.
+fn pack_region(p: &PreparedRegion, holes: &[[Plane; 6]], levels: &[UVec3], brick_offset: UVec3, out: &mut PackedScene) -> GpuRegion {
     let plane_offset = out.planes.len() as u32;
     out.planes.extend(p.region.planes.iter().map(|pl| pl.normal.extend(pl.offset)));
     let hole_offset = out.planes.len() as u32;
-    out.planes.extend(p.region.holes.iter().flatten().map(|pl| pl.normal.extend(pl.offset)));
+    out.planes.extend(holes.iter().flatten().map(|pl| pl.normal.extend(pl.offset)));
     let lut_offset = out.lut.len() as u32;
     let mut flags = 0;
     let (lut_a, lut_b, lut_width, labels) = match &p.lookup {
@@ -462,7 +472,7 @@ fn pack_region(p: &PreparedRegion, levels: &[UVec3], brick_offset: UVec3, out: &
         plane_offset,
         plane_count: p.region.planes.len() as u32,
         hole_offset,
-        hole_count: p.region.holes.len() as u32,
+        hole_count: holes.len() as u32,
         mode: mode_number(p.mode),
         flags,
         lut_offset,
@@ -535,8 +545,11 @@ pub fn polyhedron_sphere(planes: &[crate::region::Plane]) -> Vec4 {
     center.extend(radius * (1.0 + 1e-4) + 1e-3)
 }
 
+mod insets;
 mod packed;
 mod selection;
+pub use insets::{Inset, MAX_INSETS, inset_count, inset_features, insets};
+use insets::{draw_in_place, kept_holes};
 pub use packed::{Atlas, LUT_ATLAS_WIDTH, PackedScene, atlas_layout};
 pub use selection::{companions, constant_bricks, doi_channels};
 use selection::{draw_in, pack_selection};

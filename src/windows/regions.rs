@@ -8,7 +8,9 @@
 //! three segments: the dataset before the box, the window, the dataset behind it).
 //! Windows never cut each other's contents, so where windows overlap their contents
 //! composite sample by sample, and where clip windows overlap the datasets are cut by
-//! the union of the boxes (each box a hole).
+//! the union of the boxes (each box a hole). (The GPU packing draws a clip window that
+//! shows its dataset in place as the dataset's region with the window's table inside
+//! the box, the same picture without the segments: `render::pack::insets`.)
 
 use std::sync::Arc;
 

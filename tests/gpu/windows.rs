@@ -1,7 +1,9 @@
 //! GPU image tests of volumetric windows: a clip window through the whole head shows
-//! nothing of the main view inside it (only its own content), a window magnifying a
-//! source box shows the feature there enlarged by the magnification (its area by the
-//! square), and both match the CPU reference of the same regions.
+//! nothing of the main view inside it (only its own content), clip windows showing the
+//! head in place with other looks (drawn in the head's samples, `render::pack::insets`)
+//! beside one that cannot be, a window magnifying a source box shows the feature there
+//! enlarged by the magnification (its area by the square), and all match the CPU
+//! reference of the same regions.
 
 use super::*;
 use focal::dataset::SceneRegions;
@@ -39,6 +41,47 @@ pub fn a_clip_window_shows_nothing_of_the_main_view_inside(gpu: &mut Gpu) {
     let lit =
         (26..38).flat_map(|y| (26..38).map(move |x| (x, y))).filter(|&(x, y)| g.get_pixel(x, y).0[..3].iter().any(|c| *c > 30)).count();
     assert!(lit > 20, "the window's bone content shows: {lit} pixels");
+}
+
+pub fn clip_windows_drawn_in_place_match_the_reference(gpu: &mut Gpu) {
+    use focal::render::gpu_types::features;
+    let ct = head();
+    let look = |mode: Mode, tf: &str| Appearance::new(mode, presets::builtin(tf).unwrap());
+    gpu.clear();
+    let data = gpu.off.world_mut().spawn((Dataset::new(ct.clone(), look(Mode::Dvr, "ct_skin_bone")), Transform::default())).id();
+    let cam = framed(&ct, View::Superior, false);
+    gpu.off.set_camera(&cam);
+    // Four deep boxes into the top of the head, one a quadrant, each showing the head
+    // in place with another look, and a small one between them in MIP (another mode: a
+    // region of its own and a hole).
+    let (lo, hi) = ct.grid.world_bounds();
+    let at = |f: Vec3| lo + (hi - lo) * f;
+    let quadrant = (hi - lo) * Vec3::new(0.2, 0.2, 0.5);
+    let windows = [
+        (Vec3::new(0.35, 0.35, 0.75), quadrant, look(Mode::Dvr, "ct_soft_tissue")),
+        (Vec3::new(0.65, 0.35, 0.75), quadrant, look(Mode::Dvr, "ct_bone")),
+        (Vec3::new(0.35, 0.65, 0.75), quadrant, look(Mode::Dvr, "grayscale_ramp")),
+        (Vec3::new(0.65, 0.65, 0.75), quadrant, look(Mode::Dvr, "ct_vessels")),
+        (Vec3::new(0.5, 0.5, 0.75), (hi - lo) * Vec3::new(0.08, 0.08, 0.5), look(Mode::Mip, "grayscale_ramp")),
+    ];
+    for (f, size, a) in windows {
+        let w = VolumeWindow { clip: true, ..VolumeWindow::new(size, vec![Content { dataset: data, appearance: Some(a) }]) };
+        gpu.off.world_mut().spawn((w, Transform::from_translation(at(f))));
+    }
+    let g = gpu.off.capture().unwrap();
+    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
+    let packed = focal::render::pack::pack(&scene, 2048).unwrap();
+    let wanted = features::INSETS | features::MANY_INSETS | features::HOLES;
+    assert_eq!(packed.features & wanted, wanted, "four windows in place, the MIP one a hole");
+    assert_eq!(packed.region_count, 2, "the head and the MIP window");
+    assert_matches("clip_windows_in_place", &g, &reference_of_app(gpu, &cam));
+    // The windows show something of their own: the picture differs from the head's.
+    gpu.clear();
+    gpu.off.world_mut().spawn((Dataset::new(ct.clone(), look(Mode::Dvr, "ct_skin_bone")), Transform::default()));
+    gpu.off.set_camera(&cam);
+    let plain = gpu.off.capture().unwrap();
+    let (mean, _, _) = difference(&g, &plain);
+    assert!(mean > 2.0, "the windows changed little (mean {mean:.2} levels)");
 }
 
 pub fn a_magnifying_window_enlarges_its_source(gpu: &mut Gpu) {

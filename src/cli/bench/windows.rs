@@ -19,7 +19,8 @@
 //! - the head as two datasets clipped to one half each (two regions, the same picture).
 //!
 //! Goals (issue 24): one clip window ≤ ×1.05, four windows ≤ ×1.15, for windows that
-//! show the dataset as it is (the windows' own cost);
+//! show the dataset as it is (the windows' own cost; such clip windows, and the bone
+//! cutaway, are drawn in the dataset's samples: `render::pack::insets`);
 //! the figures' windows are timed too, with what they add to the picture.
 
 use std::sync::Arc;

@@ -39,9 +39,15 @@ pub fn doi_channels(prepared: &[PreparedRegion], all: &[std::sync::Arc<crate::vo
 /// Draws region record `b` in the samples of region `a` ([`companions`]): `a` names it
 /// (`objects.z`) and skips only the bricks where neither draws.
 pub(super) fn draw_in(out: &mut PackedScene, a: usize, b: usize) {
-    let (ra, rb) = (out.regions[a], out.regions[b]);
     out.regions[a].flags |= region_flags::COMPANION;
     out.regions[a].objects.z = b as u32;
+    merge_occupancy(out, a, b);
+}
+
+/// Region `a`, which draws region `b`'s look in its samples, skips only the bricks
+/// where neither draws.
+pub(super) fn merge_occupancy(out: &mut PackedScene, a: usize, b: usize) {
+    let (ra, rb) = (out.regions[a], out.regions[b]);
     if ra.flags & region_flags::OCCUPANCY != 0 {
         if rb.flags & region_flags::OCCUPANCY == 0 {
             out.regions[a].flags &= !region_flags::OCCUPANCY;

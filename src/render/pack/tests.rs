@@ -139,7 +139,10 @@ fn overlapping_regions_need_the_multi_region_code_touching_ones_do_not() {
     mixed.appearances.push(Appearance::new(Mode::Mip, presets::builtin("grayscale_ramp").unwrap()));
     mixed.regions[1].appearance = 1;
     assert_ne!(pack(&mixed, 2048).unwrap().features & features::MULTI_REGION, 0);
-    // Unless that half is a hole in the whole (a clip window and its content).
+    // Unless that half is a hole in the whole (a clip window and its content, here
+    // showing other voxels: a window showing the same ones is drawn in place,
+    // `insets`).
+    scene.regions[1].world_to_voxel = glam::Affine3A::from_translation(glam::Vec3::X) * scene.regions[1].world_to_voxel;
     let (lo, hi) = v.grid.world_bounds();
     let half = crate::region::box_planes(&glam::Affine3A::IDENTITY, glam::Vec3::new(centre.x, lo.y - 1.0, lo.z - 1.0), hi + 1.0);
     scene.regions[0].holes.push(std::array::from_fn(|i| half[i]));
