@@ -21,6 +21,7 @@ pub mod reference;
 pub mod region;
 pub mod render;
 pub mod scene;
+pub mod slices;
 pub mod streaming;
 pub mod transfer;
 pub mod twolevel;

@@ -115,3 +115,57 @@ fn convert_writes_a_pyramid_that_info_and_render_open() {
     let bad = focal().args(["info", "procedural:12x7"]).output().unwrap();
     assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("NXxNYxNZ"));
 }
+
+#[test]
+fn render_slice_shows_the_voxels_through_the_window() {
+    // A 5×4×3 raw volume (identity orientation: i right, j anterior, k superior) whose
+    // voxel (i, j, k) holds i + 10 j + 100 k; window 256 at level 128 maps each value to
+    // the same grey (DICOM's linear function: ((x − 127.5)/255 + ½)·255 = x).
+    let dir = scratch("cli-slice");
+    let raw = dir.join("counts.raw");
+    let bytes: Vec<u8> = (0..3).flat_map(|k| (0..4).flat_map(move |j| (0..5).map(move |i| (i + 10 * j + 100 * k) as u8))).collect();
+    std::fs::write(&raw, bytes).unwrap();
+    let slice = |spec: &str, name: &str| {
+        let png = dir.join(name);
+        let out = focal()
+            .args(["render", "--raw", "5x4x3:u8", "--window", "256", "--level", "128", "--slice", spec, "--out"])
+            .arg(&png)
+            .arg(&raw)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        (image::open(&png).unwrap().to_luma8(), String::from_utf8_lossy(&out.stderr).to_string())
+    };
+    // Axial slice 1 seen from the feet: the patient's right (i = 4) on the left, anterior
+    // (j = 3) at the top.
+    let (img, said) = slice("axial:1", "axial.png");
+    assert_eq!(img.dimensions(), (5, 4));
+    assert!(said.contains("axial (Z) slice 1 of 3, 5×4 pixels"), "{said}");
+    for (x, y, p) in img.enumerate_pixels() {
+        assert_eq!(p[0] as u32, (4 - x) + 10 * (3 - y) + 100, "axial ({x}, {y})");
+    }
+    // Coronal, the middle slice (j = 2): right on the left, superior at the top.
+    let (img, _) = slice("coronal", "coronal.png");
+    assert_eq!(img.dimensions(), (5, 3));
+    for (x, y, p) in img.enumerate_pixels() {
+        assert_eq!(p[0] as u32, (4 - x) + 20 + 100 * (2 - y), "coronal ({x}, {y})");
+    }
+    // Sagittal slice 2 from the patient's left: anterior on the left, superior up.
+    let (img, _) = slice("sagittal:2", "sagittal.png");
+    assert_eq!(img.dimensions(), (4, 3));
+    for (x, y, p) in img.enumerate_pixels() {
+        assert_eq!(p[0] as u32, 2 + 10 * (3 - x) + 100 * (2 - y), "sagittal ({x}, {y})");
+    }
+    // A streamed source slices at its own level 0; bad arguments are errors that say why.
+    let png = dir.join("procedural.png");
+    let out = focal().args(["render", "procedural:96", "--slice", "z", "--out"]).arg(&png).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(image::open(&png).unwrap().to_rgba8().dimensions(), (96, 96));
+    let out = focal().args(["render", "phantom:sphere", "--slice", "oblique"]).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("axial, coronal, sagittal"));
+    let out = focal().args(["render", "phantom:sphere", "--slice", "axial", "--window", "400"]).output().unwrap();
+    assert!(!out.status.success(), "a window without a level");
+    let out = focal().args(["render", "phantom:sphere", "--slice", "axial", "--window-preset", "liver"]).output().unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not a window preset"));
+}

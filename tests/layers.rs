@@ -34,6 +34,8 @@ const LAYERS: &[&str] = &[
     "reference",
     "windows",
     "explode",
+    // Slice views: a dataset's voxels in the three planes, through a window of values.
+    "slices",
     // Streaming bricked datasets: the bricks every view (lenses, windows, parts) wants.
     "streaming",
     // Interactive resolution: what a moving view draws at.
@@ -51,7 +53,7 @@ const LAYERS: &[&str] = &[
 /// Folders whose files are a technique: they never know scene files, the app, the
 /// command line or the GPU renderer. (The order of [`LAYERS`] implies it; this rule
 /// keeps it if the order is ever changed, and names the reason in its message.)
-const TECHNIQUES: &[&str] = &["context", "clip", "twolevel", "lens", "windows", "explode"];
+const TECHNIQUES: &[&str] = &["context", "clip", "twolevel", "lens", "windows", "explode", "slices"];
 const ABOVE_TECHNIQUES: &[&str] = &["render", "scene", "ui", "cli"];
 
 /// Every `.rs` file under `dir`, relative to it, with its text.

@@ -4,3 +4,4 @@ pub mod bench;
 pub mod convert;
 pub mod info;
 pub mod render;
+pub mod slice;

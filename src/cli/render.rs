@@ -90,6 +90,21 @@ pub struct RenderArgs {
     /// Print the process's peak resident memory when done (`peak resident memory: N MiB`).
     #[arg(long)]
     report_memory: bool,
+    /// Write one slice view instead of the 3D view: axial, coronal or sagittal (or z, y,
+    /// x), with the slice index along it (default: the middle), at the voxels'
+    /// resolution (default output `out/slice-ORIENTATION.png`).
+    #[arg(long, value_name = "ORIENTATION[:INDEX]", value_parser = super::slice::parse_slice)]
+    slice: Option<(focal::slices::Orientation, Option<u32>)>,
+    /// Window width of a slice view, in the data's units (with --level).
+    #[arg(long, requires = "level")]
+    window: Option<f64>,
+    /// Window centre (level) of a slice view, in the data's units (with --window).
+    #[arg(long, requires = "window", allow_hyphen_values = true)]
+    level: Option<f64>,
+    /// Window preset of a slice view: auto (the 1st to 99th percentile, the default),
+    /// soft tissue, lung, bone or brain (CT, Hounsfield units).
+    #[arg(long, value_name = "PRESET", conflicts_with = "window")]
+    window_preset: Option<String>,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -140,6 +155,14 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         return Err("give one data file (or several .ron scene files)".into());
     }
     let scene = scene_for(args.inputs.first().map(PathBuf::as_path), args)?;
+    if let Some((orientation, index)) = args.slice {
+        let datasets = focal::scene::load::load_datasets(&scene, Path::new("."))?;
+        let dataset = datasets.first().ok_or("no dataset to slice")?;
+        let window = super::slice::window_of(args.window, args.level, args.window_preset.as_deref(), dataset)?;
+        let image = super::slice::picture(dataset, orientation, index, window)?;
+        let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("out/slice-{}.png", orientation.names().0)));
+        return save(&image, &out);
+    }
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out/render.png"));
     let images = render_frames(scene, Path::new("."), &options(PathBuf::new()))?;
     let (_, image) = images.into_iter().next().ok_or("nothing rendered")?;
