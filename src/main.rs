@@ -31,6 +31,9 @@ struct Args {
     /// Window size WIDTHxHEIGHT.
     #[arg(long, default_value = "1440x900")]
     window: String,
+    /// Open the app with the slice views (axial, coronal, sagittal) under the 3D view.
+    #[arg(long)]
+    slices: bool,
 }
 
 #[derive(Subcommand)]
@@ -65,7 +68,7 @@ fn main() -> ExitCode {
                 eprintln!("error: window size '{}' is not WIDTHxHEIGHT", args.window);
                 return ExitCode::FAILURE;
             };
-            match focal::ui::run(args.volume.clone(), automation, window) {
+            match focal::ui::run(args.volume.clone(), automation, window, args.slices) {
                 bevy::app::AppExit::Success => Ok(()),
                 bevy::app::AppExit::Error(code) => Err(format!("the app stopped with code {code}")),
             }

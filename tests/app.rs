@@ -355,3 +355,37 @@ fn the_app_shows_what_streaming_does_in_the_viewport_over_a_clean_picture() {
     });
     assert_eq!(stale.count(), 0, "yellow text of earlier frames in {}", shot.display());
 }
+
+#[test]
+fn the_app_shows_slice_views_of_the_data_under_the_3d_view() {
+    let dir = scratch("app-slices");
+    let shot = dir.join("slices.png");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_focal"))
+        .arg(data("mri/ch2.nii.gz"))
+        .args(["--slices", "--frames", "4", "--window", "900x600", "--screenshot"])
+        .arg(&shot)
+        .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&shot).unwrap().to_rgba8();
+    let (w, h) = img.dimensions();
+    // Under the 3D view, right of the side panel: the three slices (MRI greys, the brain
+    // bright), each framed in its view's colour with the crosshair's lines.
+    let left = viewport_left(&img).unwrap_or(w / 3);
+    let bottom = |f: &dyn Fn(&image::Rgba<u8>) -> bool| {
+        (h * 6 / 10..h).flat_map(|y| (left..w).map(move |x| (x, y))).filter(|&(x, y)| f(img.get_pixel(x, y))).count()
+    };
+    let greys = bottom(&|p| p[0] == p[1] && p[1] == p[2] && p[0] > 90);
+    let red = bottom(&|p| p[0] > 200 && p[1] < 110 && p[2] < 110);
+    let green = bottom(&|p| p[1] > 180 && p[0] < 130 && p[2] < 130);
+    let yellow = bottom(&|p| p[0] > 200 && p[1] > 190 && p[2] < 120);
+    println!("bottom of the window: {greys} bright greys, {red} red, {green} green, {yellow} yellow pixels");
+    assert!(greys > 5000, "the slices show little of the MRI: {greys} grey pixels in {}", shot.display());
+    assert!(red > 100 && green > 100 && yellow > 100, "frames and crosshairs: {red} red, {green} green, {yellow} yellow");
+    // The 3D view is still drawn above them.
+    let view = (h / 10..h / 2).flat_map(|y| (left..w).map(move |x| (x, y))).filter(|&(x, y)| img.get_pixel(x, y)[0] > 60).count();
+    assert!(view > 2000, "the 3D view shows {view} lit pixels");
+}

@@ -29,6 +29,8 @@ pub struct FocalAppPlugin {
     pub initial: Option<PathBuf>,
     /// Automation for tests: screenshot after N frames to a path, then exit.
     pub screenshot_and_exit: Option<(u32, PathBuf)>,
+    /// Open with the slice views shown.
+    pub slices: bool,
 }
 
 impl Plugin for FocalAppPlugin {
@@ -43,6 +45,7 @@ impl Plugin for FocalAppPlugin {
             .init_resource::<explode_tools::ExplodeUi>()
             .init_resource::<explode_overlay::CutPreview>()
             .init_resource::<super::streaming_status::LevelUnderCursor>()
+            .insert_resource(super::slice_views::SliceViews::shown(self.slices))
             .add_systems(
                 Startup,
                 move |mut commands: Commands, mut egui: ResMut<EguiGlobalSettings>, mut load: MessageWriter<LoadRequest>| {
@@ -76,7 +79,12 @@ impl Plugin for FocalAppPlugin {
             // The exploded views' physics: as many steps as the frame's time asks for.
             .add_systems(
                 Update,
-                (crate::explode::systems::run_steps, open_explode_panel, super::streaming_status::level_under_cursor)
+                (
+                    crate::explode::systems::run_steps,
+                    open_explode_panel,
+                    super::streaming_status::level_under_cursor,
+                    super::slice_views::slice_keys,
+                )
                     .after(orbit::apply_orbit),
             )
             .add_systems(
@@ -337,13 +345,13 @@ fn automation(
 }
 
 /// Runs the app.
-pub fn run(initial: Option<PathBuf>, screenshot_and_exit: Option<(u32, PathBuf)>, window: (u32, u32)) -> AppExit {
+pub fn run(initial: Option<PathBuf>, screenshot_and_exit: Option<(u32, PathBuf)>, window: (u32, u32), slices: bool) -> AppExit {
     App::new()
         .add_plugins(DefaultPlugins.set(WindowPlugin {
             primary_window: Some(Window { title: "Focal".into(), resolution: window.into(), ..default() }),
             ..default()
         }))
         .add_plugins((crate::FocalPlugins, crate::windows::frames::WindowFramePlugin))
-        .add_plugins(FocalAppPlugin { initial, screenshot_and_exit })
+        .add_plugins(FocalAppPlugin { initial, screenshot_and_exit, slices })
         .run()
 }

@@ -20,6 +20,7 @@ pub mod loading;
 pub mod objects_panel;
 pub mod orbit;
 pub mod panels;
+pub mod slice_views;
 pub mod state;
 pub mod streaming_status;
 pub mod tf_editor;

@@ -86,7 +86,8 @@ pub fn ui(
     mut lens_params: lenses::LensParams,
     clip_gizmo: Res<super::clip_gizmo::ClipGizmo>,
     mut window_params: super::windows_panel::WindowParams,
-    explode_specs: Res<crate::explode::edit::CurrentSpecs>,
+    // (A tuple: a system takes at most 16 parameters.)
+    (explode_specs, mut slice_views): (Res<crate::explode::edit::CurrentSpecs>, ResMut<super::slice_views::SliceViews>),
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(
@@ -118,6 +119,7 @@ pub fn ui(
                 ui.checkbox(&mut state.show_help, "Help  (H)");
                 ui.checkbox(&mut state.show_fps, "Frame rate  (F)");
                 ui.checkbox(&mut state.show_explode, "Exploded view  (E)");
+                ui.checkbox(&mut slice_views.show, "Slice views  (L)");
             });
             for l in &loading {
                 ui.separator();
@@ -230,6 +232,15 @@ pub fn ui(
         });
     });
 
+    // The slice views of the selected dataset under the 3D view, with a label dataset
+    // to lay over them.
+    {
+        let mut rows: Vec<_> = datasets.iter().map(|(e, d, _, _, t)| (e, d, t)).collect();
+        rows.sort_by_key(|(e, ..)| *e);
+        let shown = rows.get(state.selected.min(rows.len().saturating_sub(1))).copied();
+        let labels = rows.iter().copied().find(|(e, d, _)| d.labels.is_some() && shown.is_some_and(|s| s.0 != *e));
+        super::slice_views::panel(&mut root, &mut slice_views, shown, labels);
+    }
     // The rest of the window is the 3D viewport.
     let free = root.available_rect_before_wrap();
     if let (Ok((_, mut camera, _)), Ok(window)) = (cams.single_mut(), windows.single()) {
@@ -245,6 +256,7 @@ pub fn ui(
         let chosen = rows.get(state.selected.min(rows.len().saturating_sub(1))).copied();
         let camera = cams.single().ok().map(|(o, ..)| o.camera());
         super::clip_gizmo::overlay(&ctx, free, &clip_gizmo, chosen, camera);
+        super::slice_views::planes_overlay(&ctx, free, &slice_views, chosen, camera);
     }
     if let Ok((orbit, ..)) = cams.single() {
         window_menu(&ctx, free, &mut window_params, &datasets, orbit, &regions);

@@ -36,6 +36,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Ctrl+S", "save the scene"),
     ("F12 or S", "save a screenshot (out/)"),
     ("F", "show the frame rate"),
+    ("L", "slice views on / off (click: crosshair; wheel: slice; right drag: window/level)"),
     ("H or F1", "this help"),
 ];
 

@@ -1,0 +1,281 @@
+//! The slice views beside the 3D view (View ▸ Slice views, or L): axial, coronal and
+//! sagittal slices of the selected dataset at its voxels' resolution, linked by one
+//! crosshair (`slices::crosshair`), with window/level (right drag, presets, auto) and a
+//! label dataset laid over in its colours. Click or drag in a slice: the crosshair
+//! moves there; wheel: the next or previous slice; the value under the cursor shows
+//! below. The 3D view shows the three planes' outlines.
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+use bevy_egui::egui::{self, Color32, Rect, Stroke, pos2};
+
+use crate::dataset::Dataset;
+use crate::slices::{CT_PRESETS, Orientation, Slice, SliceAxes, WindowLevel, crosshair, overlay_labels};
+use crate::volume::Volume;
+
+/// The views' colours, as 3D Slicer's: axial red, coronal green, sagittal yellow.
+pub fn colour(o: Orientation) -> Color32 {
+    match o {
+        Orientation::Axial => Color32::from_rgb(240, 80, 80),
+        Orientation::Coronal => Color32::from_rgb(90, 210, 90),
+        Orientation::Sagittal => Color32::from_rgb(240, 220, 80),
+    }
+}
+
+/// Opacity of a label dataset laid over the slices.
+const OVERLAY_OPACITY: f32 = 0.45;
+
+/// What the slice views show and what they drew.
+#[derive(Resource, Default)]
+pub struct SliceViews {
+    pub show: bool,
+    /// The crosshair in the shown dataset's frame (`None`: its centre).
+    pub crosshair: Option<Vec3>,
+    /// The window per dataset (`None`: auto until the user sets one).
+    pub window: Option<(Entity, WindowLevel)>,
+    /// Lay the other datasets' labels over the slices.
+    pub overlay: bool,
+    /// The value under the cursor, for the status line.
+    pub probe: Option<String>,
+    pictures: [Option<Picture>; 3],
+}
+
+impl SliceViews {
+    /// The views, shown or not.
+    pub fn shown(show: bool) -> SliceViews {
+        SliceViews { show, ..Default::default() }
+    }
+}
+
+/// A slice's texture and what it shows.
+struct Picture {
+    key: Key,
+    texture: egui::TextureHandle,
+    slice: Slice,
+}
+
+/// (Volumes by their address: a loaded or replaced volume is a new one.)
+#[derive(Clone, PartialEq)]
+struct Key {
+    dataset: Entity,
+    volume: usize,
+    index: u32,
+    window: Option<(u64, u64)>,
+    overlay: Option<usize>,
+}
+
+/// One dataset as the views need it: entity, component, transform.
+pub type Shown<'a> = (Entity, &'a Dataset, &'a Transform);
+
+/// The panel under the 3D view (`root`'s bottom), for dataset `shown`; `labels` a label
+/// dataset to lay over.
+pub fn panel(root: &mut egui::Ui, views: &mut SliceViews, shown: Option<Shown>, labels: Option<Shown>) {
+    if !views.show {
+        return;
+    }
+    let Some((entity, dataset, _)) = shown else { return };
+    let volume = &dataset.volume;
+    let grid = &volume.grid;
+    let point = views.crosshair.unwrap_or_else(|| grid.index_to_world().transform_point3((grid.dims.as_vec3() - 1.0) * 0.5));
+    let window = match views.window {
+        Some((e, w)) if e == entity => w,
+        _ => WindowLevel::auto(&volume.stats),
+    };
+    let is_labels = dataset.labels.is_some();
+    views.probe = None;
+    egui::Panel::bottom("slice_views").resizable(true).default_size(280.0).min_size(120.0).show(root, |ui| {
+        ui.horizontal(|ui| {
+            ui.label(egui::RichText::new(format!("Slices of {}", volume.name)).strong());
+            if !is_labels {
+                ui.separator();
+                let mut w = window;
+                ui.label("Window")
+                    .on_hover_text("Width of the values shown as greys (the data's units); right drag in a slice: left/right");
+                ui.add(egui::DragValue::new(&mut w.width).speed(range_step(volume)).range(1.0..=f64::MAX));
+                ui.label("Level").on_hover_text("Centre of the window; right drag in a slice: up/down");
+                ui.add(egui::DragValue::new(&mut w.level).speed(range_step(volume)));
+                egui::ComboBox::from_id_salt("wl_preset").selected_text("Preset").show_ui(ui, |ui| {
+                    if ui.selectable_label(false, "auto (1st–99th percentile)").clicked() {
+                        w = WindowLevel::auto(&volume.stats);
+                    }
+                    for (name, width, level) in CT_PRESETS {
+                        if ui.selectable_label(false, format!("CT {name} ({width}/{level})")).clicked() {
+                            w = WindowLevel::new(width, level);
+                        }
+                    }
+                });
+                if w != window {
+                    views.window = Some((entity, w));
+                }
+            }
+            if labels.is_some() {
+                ui.separator();
+                ui.checkbox(&mut views.overlay, "Labels over").on_hover_text("Lay the label dataset over the slices in its colours");
+            }
+        });
+        let room = ui.available_size();
+        let cell = egui::vec2((room.x - 16.0) / 3.0, room.y - 22.0);
+        ui.horizontal(|ui| {
+            for (k, o) in Orientation::ALL.into_iter().enumerate() {
+                ui.vertical(|ui| {
+                    ui.set_width(cell.x);
+                    view(ui, views, k, o, (entity, dataset), point, window, labels.filter(|_| views.overlay), cell);
+                });
+            }
+        });
+    });
+}
+
+/// A step of the window drags: a 500th of the value range.
+fn range_step(volume: &Volume) -> f64 {
+    ((volume.stats.max - volume.stats.min) / 500.0).max(0.01)
+}
+
+/// One slice view: header, picture, crosshair, interaction.
+#[allow(clippy::too_many_arguments)]
+fn view(
+    ui: &mut egui::Ui,
+    views: &mut SliceViews,
+    k: usize,
+    o: Orientation,
+    (entity, dataset): (Entity, &Dataset),
+    point: Vec3,
+    window: WindowLevel,
+    overlay: Option<Shown>,
+    cell: egui::Vec2,
+) {
+    let volume = &dataset.volume;
+    let grid = &volume.grid;
+    let axes = SliceAxes::of(grid.direction, o);
+    let index = crosshair::slice_through(&axes, grid, point);
+    let (medical, axis) = o.names();
+    ui.label(egui::RichText::new(format!("{medical} ({axis})  {} / {}", index + 1, axes.count(grid.dims))).color(colour(o)));
+    let key = Key {
+        dataset: entity,
+        volume: Arc::as_ptr(volume) as usize,
+        index,
+        window: dataset.labels.is_none().then(|| (window.width.to_bits(), window.level.to_bits())),
+        overlay: overlay.map(|(_, d, _)| Arc::as_ptr(&d.volume) as usize),
+    };
+    if views.pictures[k].as_ref().is_none_or(|p| p.key != key) {
+        let slice = Slice::of_volume(volume, axes, index);
+        let mut pixels = match &dataset.labels {
+            Some(table) => slice.labels(table),
+            None => slice.grey(&window),
+        };
+        if let Some((_, labels, transform)) = overlay
+            && let Some(table) = &labels.labels
+        {
+            overlay_labels(&mut pixels, &slice, &labels.volume, transform.compute_affine(), table, OVERLAY_OPACITY);
+        }
+        let rgba: Vec<u8> = pixels.iter().flatten().copied().collect();
+        let image = egui::ColorImage::from_rgba_unmultiplied([slice.width as usize, slice.height as usize], &rgba);
+        let texture = match views.pictures[k].take() {
+            Some(mut p) => {
+                p.texture.set(image, egui::TextureOptions::NEAREST);
+                p.texture
+            }
+            None => ui.ctx().load_texture(format!("slice_{medical}"), image, egui::TextureOptions::NEAREST),
+        };
+        views.pictures[k] = Some(Picture { key, texture, slice });
+    }
+    let Some(picture) = &views.pictures[k] else { return };
+    let size = crosshair::fit((picture.slice.width, picture.slice.height), axes.pixel_mm(grid.spacing), glam::Vec2::new(cell.x, cell.y));
+    let (rect, response) = ui.allocate_exact_size(egui::vec2(size.x, size.y), egui::Sense::click_and_drag());
+    let painter = ui.painter_at(rect);
+    painter.image(picture.texture.id(), rect, Rect::from_min_max(pos2(0.0, 0.0), pos2(1.0, 1.0)), Color32::WHITE);
+    let (w, h) = (picture.slice.width as f32, picture.slice.height as f32);
+    let to_screen = |px: glam::Vec2| pos2(rect.left() + (px.x + 0.5) / w * rect.width(), rect.top() + (px.y + 0.5) / h * rect.height());
+    let to_pixel =
+        |p: egui::Pos2| glam::Vec2::new((p.x - rect.left()) / rect.width() * w - 0.5, (p.y - rect.top()) / rect.height() * h - 0.5);
+    // The other two planes through the crosshair, in their colours.
+    let at = to_screen(crosshair::pixel_of(&axes, grid, point));
+    for other in Orientation::ALL.into_iter().filter(|x| *x != o) {
+        let along_rows = SliceAxes::of(grid.direction, other).normal == axes.column.0;
+        let line = if along_rows {
+            [pos2(at.x, rect.top()), pos2(at.x, rect.bottom())]
+        } else {
+            [pos2(rect.left(), at.y), pos2(rect.right(), at.y)]
+        };
+        painter.line_segment(line, Stroke::new(1.0, colour(other).gamma_multiply(0.8)));
+    }
+    painter.rect_stroke(rect, 0.0, Stroke::new(1.0, colour(o)), egui::StrokeKind::Inside);
+    // Interaction.
+    if (response.clicked() || response.dragged_by(egui::PointerButton::Primary))
+        && let Some(p) = response.interact_pointer_pos()
+    {
+        views.crosshair = Some(crosshair::point_at(&axes, grid, index, to_pixel(p)));
+    }
+    if response.dragged_by(egui::PointerButton::Secondary) && dataset.labels.is_none() {
+        let d = response.drag_delta();
+        views.window = Some((entity, window.dragged(d.x, d.y, range_step(volume))));
+    }
+    if let Some(p) = response.hover_pos() {
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            let count = axes.count(grid.dims) as i64;
+            let next = (index as i64 + scroll.signum() as i64).clamp(0, count - 1) as u32;
+            let mut q = grid.world_to_index().transform_point3(point);
+            q[axes.normal] = next as f32;
+            let moved = grid.index_to_world().transform_point3(q);
+            views.crosshair = Some(moved);
+        }
+        views.probe = probe(&picture.slice, dataset, to_pixel(p));
+    }
+}
+
+/// The value (and label) of the voxel under continuous pixel `px`.
+fn probe(slice: &Slice, dataset: &Dataset, px: glam::Vec2) -> Option<String> {
+    let (x, y) = (px.x.round(), px.y.round());
+    if x < 0.0 || y < 0.0 || x >= slice.width as f32 || y >= slice.height as f32 {
+        return None;
+    }
+    let v = slice.axes.voxel(slice.grid.dims, slice.index, x as u32, y as u32);
+    let code = slice.codes[(y as u32 * slice.width + x as u32) as usize];
+    let value = slice.values.to_real(code as f64);
+    let units = slice.values.units.as_deref().map(|u| format!(" {u}")).unwrap_or_default();
+    Some(match &dataset.labels {
+        Some(table) => format!("voxel ({}, {}, {}): label {} {}", v.x, v.y, v.z, value, table.name(value as u32)),
+        None => format!("voxel ({}, {}, {}): {value}{units}", v.x, v.y, v.z),
+    })
+}
+
+/// The three planes' outlines in the 3D view (`free`), for the dataset shown.
+pub fn planes_overlay(ctx: &egui::Context, free: Rect, views: &SliceViews, shown: Option<Shown>, camera: Option<crate::region::Camera>) {
+    let (true, Some((_, dataset, transform)), Some(camera)) = (views.show, shown, camera) else { return };
+    let grid = &dataset.volume.grid;
+    let point = views.crosshair.unwrap_or_else(|| grid.index_to_world().transform_point3((grid.dims.as_vec3() - 1.0) * 0.5));
+    let painter = ctx.layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::new("slice_planes"))).with_clip_rect(free);
+    let to_world = transform.compute_affine();
+    for o in Orientation::ALL {
+        let axes = SliceAxes::of(grid.direction, o);
+        let index = crosshair::slice_through(&axes, grid, point);
+        let corners = crosshair::corners(&axes, grid, index);
+        let on_screen: Option<Vec<egui::Pos2>> = corners
+            .iter()
+            .map(|c| {
+                camera
+                    .to_pixel(to_world.transform_point3(*c), free.width(), free.height())
+                    .map(|p| pos2(free.left() + p.x, free.top() + p.y))
+            })
+            .collect();
+        if let Some(mut outline) = on_screen {
+            outline.push(outline[0]);
+            painter.line(outline, Stroke::new(1.5, colour(o)));
+        }
+    }
+    if let Some(text) = &views.probe {
+        painter.text(free.left_top() + egui::vec2(8.0, 8.0), egui::Align2::LEFT_TOP, text, egui::FontId::monospace(13.0), Color32::WHITE);
+    }
+}
+
+/// L: the slice views on and off.
+pub fn slice_keys(keys: Res<ButtonInput<KeyCode>>, mut contexts: bevy_egui::EguiContexts, mut views: ResMut<SliceViews>) {
+    if contexts.ctx_mut().is_ok_and(|c| c.egui_wants_keyboard_input()) {
+        return;
+    }
+    if keys.just_pressed(KeyCode::KeyL) {
+        views.show = !views.show;
+    }
+}
