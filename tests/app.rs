@@ -360,10 +360,20 @@ fn the_app_shows_what_streaming_does_in_the_viewport_over_a_clean_picture() {
 fn the_app_shows_slice_views_of_the_data_under_the_3d_view() {
     let dir = scratch("app-slices");
     let shot = dir.join("slices.png");
+    // ch2 with a clip window on the patient's left, front and top: the axial and sagittal
+    // slices through the middle pass through it.
+    let scene = dir.join("window.ron");
+    let text = format!(
+        r#"(datasets: [(source: File({:?}), appearance: (mode: dvr, preset: Some("mr_default")))],
+            windows: [(center: (-30.0, 30.0, 30.0), size: (60.0, 50.0, 50.0), clip: true,
+                       contents: [(dataset: 0, appearance: Some((mode: dvr, preset: Some("grayscale_ramp"))))])])"#,
+        data("mri/ch2.nii.gz")
+    );
+    std::fs::write(&scene, text).unwrap();
     let out = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1024x768x24"])
         .arg(env!("CARGO_BIN_EXE_focal"))
-        .arg(data("mri/ch2.nii.gz"))
+        .arg(&scene)
         .args(["--slices", "--frames", "4", "--window", "900x600", "--screenshot"])
         .arg(&shot)
         .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
@@ -382,7 +392,9 @@ fn the_app_shows_slice_views_of_the_data_under_the_3d_view() {
     let red = bottom(&|p| p[0] > 200 && p[1] < 110 && p[2] < 110);
     let green = bottom(&|p| p[1] > 180 && p[0] < 130 && p[2] < 130);
     let yellow = bottom(&|p| p[0] > 200 && p[1] > 190 && p[2] < 120);
-    println!("bottom of the window: {greys} bright greys, {red} red, {green} green, {yellow} yellow pixels");
+    let outline = bottom(&|p| p[2] as i32 > p[0] as i32 + 60 && p[1] as i32 > p[0] as i32 + 30);
+    println!("bottom of the window: {greys} bright greys, {red} red, {green} green, {yellow} yellow, {outline} window outline pixels");
+    assert!(outline > 60, "the window's outline on the slices: {outline} pixels in {}", shot.display());
     assert!(greys > 5000, "the slices show little of the MRI: {greys} grey pixels in {}", shot.display());
     assert!(red > 100 && green > 100 && yellow > 100, "frames and crosshairs: {red} red, {green} green, {yellow} yellow");
     // The 3D view is still drawn above them.

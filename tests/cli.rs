@@ -169,3 +169,24 @@ fn render_slice_shows_the_voxels_through_the_window() {
     let out = focal().args(["render", "phantom:sphere", "--slice", "axial", "--window-preset", "liver"]).output().unwrap();
     assert!(String::from_utf8_lossy(&out.stderr).contains("not a window preset"));
 }
+
+#[test]
+fn render_turntable_writes_an_orbit_as_pngs_and_a_gif() {
+    let dir = scratch("cli-turntable");
+    let common = ["phantom:engine", "--cpu", "--resolution", "32", "--size", "40x32", "--no-jitter", "--elevation", "20"];
+    let out = focal().arg("render").args(common).args(["--turntable", "4", "--out"]).arg(dir.join("orbit")).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let frame = |k: u32| image::open(dir.join(format!("orbit/turntable-{k:04}.png"))).unwrap().to_rgba8();
+    // Frame 1 of 4 is the view from 90°: the same picture as one render from there.
+    let single = dir.join("at90.png");
+    let out = focal().arg("render").args(common).args(["--azimuth", "90", "--out"]).arg(&single).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(frame(1), image::open(&single).unwrap().to_rgba8());
+    assert_ne!(frame(0), frame(1), "the engine turned");
+    // The GIF holds the four frames, looping.
+    use image::AnimationDecoder;
+    let gif = std::io::BufReader::new(std::fs::File::open(dir.join("orbit/turntable.gif")).unwrap());
+    let frames = image::codecs::gif::GifDecoder::new(gif).unwrap().into_frames().collect_frames().unwrap();
+    assert_eq!(frames.len(), 4);
+    assert_eq!(frames[0].buffer().dimensions(), (40, 32));
+}

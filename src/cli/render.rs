@@ -101,6 +101,11 @@ pub struct RenderArgs {
     /// Window centre (level) of a slice view, in the data's units (with --window).
     #[arg(long, requires = "window", allow_hyphen_values = true)]
     level: Option<f64>,
+    /// Write an orbit of N frames about the superior axis instead of one picture, from
+    /// --azimuth (default 0) at --elevation (default 20): a PNG sequence, an animated GIF
+    /// and, where ffmpeg is installed, an MP4 in the --out folder (default `out/turntable`).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=3600), conflicts_with = "slice")]
+    turntable: Option<u32>,
     /// Window preset of a slice view: auto (the 1st to 99th percentile, the default),
     /// soft tissue, lung, bone or brain (CT, Hounsfield units).
     #[arg(long, value_name = "PRESET", conflicts_with = "window")]
@@ -135,7 +140,7 @@ fn peak_resident_mib() -> Option<f64> {
 
 fn render(args: &RenderArgs) -> Result<(), String> {
     let size = args.size.as_deref().map(parse_size).transpose()?;
-    let options = |out_dir: PathBuf| RunOptions { out_dir, cpu: args.cpu, size };
+    let options = |out_dir: PathBuf| RunOptions { out_dir, cpu: args.cpu, size, progress: false };
     let scenes: Vec<&PathBuf> = args.inputs.iter().filter(|p| p.extension().is_some_and(|e| e == "ron")).collect();
     if !scenes.is_empty() {
         if scenes.len() != args.inputs.len() {
@@ -162,6 +167,15 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         let image = super::slice::picture(dataset, orientation, index, window)?;
         let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("out/slice-{}.png", orientation.names().0)));
         return save(&image, &out);
+    }
+    if let Some(n) = args.turntable {
+        let scene = super::movie::turntable(scene, n, args.azimuth.unwrap_or(0.0), args.elevation.unwrap_or(20.0), args.ortho, args.zoom);
+        let frames = render_frames(scene, Path::new("."), &RunOptions { progress: true, ..options(PathBuf::new()) })?;
+        let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("out/turntable"));
+        for p in super::movie::write(&frames, &dir)? {
+            println!("{}", p.display());
+        }
+        return Ok(());
     }
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out/render.png"));
     let images = render_frames(scene, Path::new("."), &options(PathBuf::new()))?;

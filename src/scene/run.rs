@@ -23,6 +23,8 @@ pub struct RunOptions {
     pub cpu: bool,
     /// Override the scene's image size.
     pub size: Option<(u32, u32)>,
+    /// Say on stderr which frame of several is being drawn.
+    pub progress: bool,
 }
 
 /// The frames to capture (one "default" frame when the file lists none).
@@ -66,7 +68,11 @@ pub fn render_frames(mut scene: SceneFile, base: &Path, options: &RunOptions) ->
     let mut camera_spec = scene.camera.clone();
     let mut gpu = if options.cpu { None } else { Some(GpuRun::new(w, h, &datasets)?) };
     let mut images = Vec::new();
-    for frame in frames(&scene) {
+    let all = frames(&scene);
+    for (k, frame) in all.iter().enumerate() {
+        if options.progress && all.len() > 1 {
+            eprint!("\rframe {}/{}", k + 1, all.len());
+        }
         for change in &frame.set {
             apply(change, &mut datasets, &mut scene, base).map_err(|e| format!("frame '{}': {e}", frame.name))?;
         }
@@ -83,6 +89,9 @@ pub fn render_frames(mut scene: SceneFile, base: &Path, options: &RunOptions) ->
             None => render_lensed(&render_scene_with_windows(&datasets, &scene, &cam, base)?, &cam, &scene.lenses, w, h)?.to_image()?,
         };
         images.push((frame.name.clone(), image));
+    }
+    if options.progress && all.len() > 1 {
+        eprintln!();
     }
     Ok(images)
 }

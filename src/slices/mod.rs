@@ -8,12 +8,14 @@
 //! - [`window_level`]: the DICOM linear VOI function, CT presets, auto from the
 //!   histogram;
 //! - [`image`]: a slice's voxels (from memory or a streamed source) and its picture;
-//! - [`crosshair`]: the point the views share, the slice and pixel that show it.
+//! - [`crosshair`]: the point the views share, the slice and pixel that show it;
+//! - [`outline`]: where a box (a volumetric window) cuts a slice.
 //!
 //! `focal render INPUT --slice axial[:INDEX]` writes one slice view as a PNG.
 
 pub mod crosshair;
 pub mod image;
+pub mod outline;
 pub mod plane;
 pub mod window_level;
 

@@ -239,7 +239,9 @@ pub fn ui(
         rows.sort_by_key(|(e, ..)| *e);
         let shown = rows.get(state.selected.min(rows.len().saturating_sub(1))).copied();
         let labels = rows.iter().copied().find(|(e, d, _)| d.labels.is_some() && shown.is_some_and(|s| s.0 != *e));
-        super::slice_views::panel(&mut root, &mut slice_views, shown, labels);
+        let boxes: Vec<[Vec3; 8]> =
+            window_params.windows.iter().map(|(_, w, g)| crate::windows::systems::window_box(w, g).corners()).collect();
+        super::slice_views::panel(&mut root, &mut slice_views, shown, labels, &boxes);
     }
     // The rest of the window is the 3D viewport.
     let free = root.available_rect_before_wrap();

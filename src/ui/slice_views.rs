@@ -11,7 +11,7 @@ use bevy::prelude::*;
 use bevy_egui::egui::{self, Color32, Rect, Stroke, pos2};
 
 use crate::dataset::Dataset;
-use crate::slices::{CT_PRESETS, Orientation, Slice, SliceAxes, WindowLevel, crosshair, overlay_labels};
+use crate::slices::{CT_PRESETS, Orientation, Slice, SliceAxes, WindowLevel, crosshair, outline, overlay_labels};
 use crate::volume::Volume;
 
 /// The views' colours, as 3D Slicer's: axial red, coronal green, sagittal yellow.
@@ -22,6 +22,9 @@ pub fn colour(o: Orientation) -> Color32 {
         Orientation::Sagittal => Color32::from_rgb(240, 220, 80),
     }
 }
+
+/// The colour of the windows' outlines on the slices.
+const WINDOW_OUTLINE: Color32 = Color32::from_rgb(90, 200, 255);
 
 /// Opacity of a label dataset laid over the slices.
 const OVERLAY_OPACITY: f32 = 0.45;
@@ -69,12 +72,16 @@ struct Key {
 pub type Shown<'a> = (Entity, &'a Dataset, &'a Transform);
 
 /// The panel under the 3D view (`root`'s bottom), for dataset `shown`; `labels` a label
-/// dataset to lay over.
-pub fn panel(root: &mut egui::Ui, views: &mut SliceViews, shown: Option<Shown>, labels: Option<Shown>) {
+/// dataset to lay over; `boxes` the volumetric windows' boxes (world corners) to
+/// outline where a slice passes through them.
+pub fn panel(root: &mut egui::Ui, views: &mut SliceViews, shown: Option<Shown>, labels: Option<Shown>, boxes: &[[Vec3; 8]]) {
     if !views.show {
         return;
     }
-    let Some((entity, dataset, _)) = shown else { return };
+    let Some((entity, dataset, transform)) = shown else { return };
+    // The boxes in the dataset's frame.
+    let to_dataset = transform.compute_affine().inverse();
+    let boxes: Vec<[Vec3; 8]> = boxes.iter().map(|b| b.map(|c| to_dataset.transform_point3(c))).collect();
     let volume = &dataset.volume;
     let grid = &volume.grid;
     let point = views.crosshair.unwrap_or_else(|| grid.index_to_world().transform_point3((grid.dims.as_vec3() - 1.0) * 0.5));
@@ -120,7 +127,7 @@ pub fn panel(root: &mut egui::Ui, views: &mut SliceViews, shown: Option<Shown>, 
             for (k, o) in Orientation::ALL.into_iter().enumerate() {
                 ui.vertical(|ui| {
                     ui.set_width(cell.x);
-                    view(ui, views, k, o, (entity, dataset), point, window, labels.filter(|_| views.overlay), cell);
+                    view(ui, views, k, o, (entity, dataset), point, window, labels.filter(|_| views.overlay), cell, &boxes);
                 });
             }
         });
@@ -144,6 +151,7 @@ fn view(
     window: WindowLevel,
     overlay: Option<Shown>,
     cell: egui::Vec2,
+    boxes: &[[Vec3; 8]],
 ) {
     let volume = &dataset.volume;
     let grid = &volume.grid;
@@ -199,6 +207,14 @@ fn view(
             [pos2(rect.left(), at.y), pos2(rect.right(), at.y)]
         };
         painter.line_segment(line, Stroke::new(1.0, colour(other).gamma_multiply(0.8)));
+    }
+    // The windows this slice passes through, as the 3D view outlines them.
+    for b in boxes {
+        let mut outline: Vec<egui::Pos2> = outline::section(b, grid, &axes, index).into_iter().map(to_screen).collect();
+        if let Some(&first) = outline.first() {
+            outline.push(first);
+            painter.extend(egui::Shape::dashed_line(&outline, Stroke::new(1.5, WINDOW_OUTLINE), 6.0, 4.0));
+        }
     }
     painter.rect_stroke(rect, 0.0, Stroke::new(1.0, colour(o)), egui::StrokeKind::Inside);
     // Interaction.

@@ -1,0 +1,105 @@
+//! `focal render INPUT --turntable N --out DIR`: an orbit of N frames around the data,
+//! written as a PNG sequence (`turntable-0000.png` …), an animated GIF (`turntable.gif`,
+//! 25 frames a second, looping) and, where `ffmpeg` is on the PATH, an MP4
+//! (`turntable.mp4`, H.264 in yuv420p, as players expect).
+
+use std::path::{Path, PathBuf};
+
+use focal::scene::file::{CameraSpec, FrameSpec, SceneFile};
+
+/// Frames a second of the GIF and MP4.
+pub const FPS: u32 = 25;
+
+/// `scene` with `n` frames orbiting once about the superior axis from `azimuth_deg`, at
+/// `elevation_deg` (the first frame is the view at `azimuth_deg`; frame k is at
+/// `azimuth_deg + 360°·k/n`).
+pub fn turntable(mut scene: SceneFile, n: u32, azimuth_deg: f32, elevation_deg: f32, orthographic: bool, zoom: f32) -> SceneFile {
+    scene.frames = (0..n)
+        .map(|k| FrameSpec {
+            name: format!("turntable-{k:04}"),
+            camera: Some(CameraSpec::Orbit { azimuth_deg: azimuth_deg + 360.0 * k as f32 / n as f32, elevation_deg, orthographic, zoom }),
+            set: Vec::new(),
+            settle: None,
+        })
+        .collect();
+    scene
+}
+
+/// Writes the frames into `dir`: the PNG sequence, the GIF, the MP4 where ffmpeg is;
+/// returns what it wrote.
+pub fn write(frames: &[(String, image::RgbaImage)], dir: &Path) -> Result<Vec<PathBuf>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut written = Vec::new();
+    for (name, image) in frames {
+        let path = dir.join(format!("{name}.png"));
+        image.save(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        written.push(path);
+    }
+    let gif = dir.join("turntable.gif");
+    write_gif(frames, &gif).map_err(|e| format!("{}: {e}", gif.display()))?;
+    written.push(gif);
+    match write_mp4(dir) {
+        Ok(Some(mp4)) => written.push(mp4),
+        Ok(None) => eprintln!("no ffmpeg on the PATH: no MP4 (the PNG sequence and the GIF are written)"),
+        Err(e) => eprintln!("warning: the MP4 was not written: {e}"),
+    }
+    Ok(written)
+}
+
+fn write_gif(frames: &[(String, image::RgbaImage)], path: &Path) -> Result<(), String> {
+    use image::codecs::gif::{GifEncoder, Repeat};
+    let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
+    let mut encoder = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
+    encoder.set_repeat(Repeat::Infinite).map_err(|e| e.to_string())?;
+    let delay = image::Delay::from_numer_denom_ms(1000, FPS);
+    for (k, (_, image)) in frames.iter().enumerate() {
+        eprint!("\rGIF frame {}/{}", k + 1, frames.len());
+        encoder.encode_frame(image::Frame::from_parts(image.clone(), 0, 0, delay)).map_err(|e| e.to_string())?;
+    }
+    eprintln!();
+    Ok(())
+}
+
+/// `turntable.mp4` from the PNG sequence with ffmpeg; `None` where there is none.
+fn write_mp4(dir: &Path) -> Result<Option<PathBuf>, String> {
+    if std::process::Command::new("ffmpeg").arg("-version").output().is_err() {
+        return Ok(None);
+    }
+    let mp4 = dir.join("turntable.mp4");
+    let out = std::process::Command::new("ffmpeg")
+        .args(["-y", "-loglevel", "error", "-framerate", &FPS.to_string(), "-i"])
+        .arg(dir.join("turntable-%04d.png"))
+        // (Even dimensions for yuv420p.)
+        .args(["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p"])
+        .arg(&mp4)
+        .output()
+        .map_err(|e| format!("ffmpeg: {e}"))?;
+    if !out.status.success() {
+        return Err(format!("ffmpeg: {}", String::from_utf8_lossy(&out.stderr).trim()));
+    }
+    Ok(Some(mp4))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_turntable_orbits_once_in_equal_steps() {
+        let scene = SceneFile::parse("(datasets: [])", "test").unwrap();
+        let t = turntable(scene, 8, 30.0, 20.0, false, 1.5);
+        let azimuths: Vec<f32> = t
+            .frames
+            .iter()
+            .map(|f| match f.camera {
+                Some(CameraSpec::Orbit { azimuth_deg, elevation_deg, zoom, .. }) => {
+                    assert_eq!((elevation_deg, zoom), (20.0, 1.5));
+                    azimuth_deg
+                }
+                _ => panic!("not an orbit"),
+            })
+            .collect();
+        assert_eq!(azimuths, vec![30.0, 75.0, 120.0, 165.0, 210.0, 255.0, 300.0, 345.0]);
+        assert_eq!(t.frames[3].name, "turntable-0003");
+    }
+}
