@@ -360,11 +360,13 @@ fn the_app_shows_what_streaming_does_in_the_viewport_over_a_clean_picture() {
 fn the_app_shows_slice_views_of_the_data_under_the_3d_view() {
     let dir = scratch("app-slices");
     let shot = dir.join("slices.png");
-    // ch2 with a clip window on the patient's left, front and top: the axial and sagittal
-    // slices through the middle pass through it.
+    // ch2 with a clip window on the patient's left, front and top (the axial and sagittal
+    // slices through the middle pass through it) and a ruler in the middle axial slice
+    // (z = 19 mm: voxel 90 of an origin at −71).
     let scene = dir.join("window.ron");
     let text = format!(
         r#"(datasets: [(source: File({:?}), appearance: (mode: dvr, preset: Some("mr_default")))],
+            rulers: [(dataset: 0, from: (-40.0, -20.0, 19.0), to: (30.0, 40.0, 19.0))],
             windows: [(center: (-30.0, 30.0, 30.0), size: (60.0, 50.0, 50.0), clip: true,
                        contents: [(dataset: 0, appearance: Some((mode: dvr, preset: Some("grayscale_ramp"))))])])"#,
         data("mri/ch2.nii.gz")
@@ -395,6 +397,9 @@ fn the_app_shows_slice_views_of_the_data_under_the_3d_view() {
     let outline = bottom(&|p| p[2] as i32 > p[0] as i32 + 60 && p[1] as i32 > p[0] as i32 + 30);
     println!("bottom of the window: {greys} bright greys, {red} red, {green} green, {yellow} yellow, {outline} window outline pixels");
     assert!(outline > 60, "the window's outline on the slices: {outline} pixels in {}", shot.display());
+    // The ruler (magenta) lies in the axial slice: a line of 92 mm with its length.
+    let ruler = bottom(&|p| p[0] > 180 && p[2] > 150 && p[1] < 120);
+    assert!(ruler > 100, "the ruler on the slices: {ruler} pixels in {}", shot.display());
     assert!(greys > 5000, "the slices show little of the MRI: {greys} grey pixels in {}", shot.display());
     assert!(red > 100 && green > 100 && yellow > 100, "frames and crosshairs: {red} red, {green} green, {yellow} yellow");
     // The 3D view is still drawn above them.

@@ -238,6 +238,7 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
         windows: Vec::new(),
         pointer: None,
         markers: Vec::new(),
+        rulers: Vec::new(),
         frames: Vec::new(),
     })
 }

@@ -72,6 +72,9 @@ pub struct SceneFile {
     /// Interpretive markers (shown in every view of their point).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub markers: Vec<crate::windows::spec::MarkerSpec>,
+    /// Distance rulers (placed in the slice views).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rulers: Vec<crate::slices::ruler::RulerSpec>,
     /// Frames to capture; none means one frame of the scene as it is.
     #[serde(default)]
     pub frames: Vec<FrameSpec>,
@@ -377,6 +380,7 @@ impl SceneFile {
         }
         self.validate_windows(&self.windows)?;
         self.markers.iter().enumerate().try_for_each(|(i, m)| m.validate(i, self.datasets.len()))?;
+        self.rulers.iter().enumerate().try_for_each(|(i, m)| m.validate(i, self.datasets.len()))?;
         for frame in &self.frames {
             for change in &frame.set {
                 let checked = match change {
@@ -474,6 +478,18 @@ mod tests {
         assert_eq!(again.rendering.view(Default::default()), view);
         // A scene without them keeps the defaults.
         assert_eq!(SceneFile::parse("(datasets: [])", "t").unwrap().rendering, RenderingSpec::default());
+    }
+
+    #[test]
+    fn rulers_are_read_checked_and_written() {
+        let text = "(datasets: [(source: Phantom(kind: head, resolution: 32))], rulers: [(dataset: 0, from: (1.0, 2.0, 3.0), to: (4.0, 6.0, 15.0))])";
+        let scene = SceneFile::parse(text, "t").unwrap();
+        assert_eq!(scene.rulers.len(), 1);
+        let again = SceneFile::parse(&scene.to_ron().unwrap(), "t").unwrap();
+        assert_eq!(again.rulers, scene.rulers);
+        scene.validate().unwrap();
+        let e = SceneFile::parse(&text.replace("dataset: 0", "dataset: 3"), "t").unwrap().validate().unwrap_err();
+        assert!(e.contains("ruler 0: refers to dataset 3"), "{e}");
     }
 
     #[test]

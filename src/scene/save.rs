@@ -109,6 +109,7 @@ pub fn scene_file(
         windows: Vec::new(),
         pointer: None,
         markers: Vec::new(),
+        rulers: Vec::new(),
         frames: Vec::new(),
     }
 }

@@ -9,7 +9,8 @@
 //!   histogram;
 //! - [`image`]: a slice's voxels (from memory or a streamed source) and its picture;
 //! - [`crosshair`]: the point the views share, the slice and pixel that show it;
-//! - [`outline`]: where a box (a volumetric window) cuts a slice.
+//! - [`outline`]: where a box (a volumetric window) cuts a slice;
+//! - [`ruler`]: distance rulers between two points of a dataset, saved with the scene.
 //!
 //! `focal render INPUT --slice axial[:INDEX]` writes one slice view as a PNG.
 
@@ -17,6 +18,7 @@ pub mod crosshair;
 pub mod image;
 pub mod outline;
 pub mod plane;
+pub mod ruler;
 pub mod window_level;
 
 pub use image::{Slice, overlay_labels, to_image};

@@ -84,6 +84,7 @@ impl Plugin for FocalAppPlugin {
                     open_explode_panel,
                     super::streaming_status::level_under_cursor,
                     super::slice_views::slice_keys,
+                    super::slice_views::apply_rulers,
                 )
                     .after(orbit::apply_orbit),
             )

@@ -166,10 +166,11 @@ pub fn finish_loads(
                     match crate::scene::load::window_appearances(&scene, &datasets, &base) {
                         Ok(looks) => {
                             let (windows, pointer) = (scene.windows.clone(), scene.pointer.map(|(x, y, z)| Vec3::new(x, y, z)));
-                            let markers = scene.markers.clone();
+                            let (markers, rulers) = (scene.markers.clone(), scene.rulers.clone());
                             commands.queue(move |world: &mut World| {
                                 crate::windows::spec::replace_windows(world, &windows, &looks, &entities, None, pointer);
                                 crate::windows::spec::replace_markers(world, &markers, &entities);
+                                crate::slices::ruler::replace_rulers(world, &rulers, &entities);
                             });
                         }
                         Err(e) => window_error = Some(format!("{}: {e}", load.what)),

@@ -87,7 +87,11 @@ pub fn ui(
     clip_gizmo: Res<super::clip_gizmo::ClipGizmo>,
     mut window_params: super::windows_panel::WindowParams,
     // (A tuple: a system takes at most 16 parameters.)
-    (explode_specs, mut slice_views): (Res<crate::explode::edit::CurrentSpecs>, ResMut<super::slice_views::SliceViews>),
+    (explode_specs, mut slice_views, rulers): (
+        Res<crate::explode::edit::CurrentSpecs>,
+        ResMut<super::slice_views::SliceViews>,
+        Query<&crate::slices::ruler::Ruler>,
+    ),
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(
@@ -241,7 +245,8 @@ pub fn ui(
         let labels = rows.iter().copied().find(|(e, d, _)| d.labels.is_some() && shown.is_some_and(|s| s.0 != *e));
         let boxes: Vec<[Vec3; 8]> =
             window_params.windows.iter().map(|(_, w, g)| crate::windows::systems::window_box(w, g).corners()).collect();
-        super::slice_views::panel(&mut root, &mut slice_views, shown, labels, &boxes);
+        let all_rulers: Vec<crate::slices::ruler::Ruler> = rulers.iter().copied().collect();
+        super::slice_views::panel(&mut root, &mut slice_views, shown, labels, &boxes, &all_rulers);
     }
     // The rest of the window is the 3D viewport.
     let free = root.available_rect_before_wrap();
@@ -258,7 +263,8 @@ pub fn ui(
         let chosen = rows.get(state.selected.min(rows.len().saturating_sub(1))).copied();
         let camera = cams.single().ok().map(|(o, ..)| o.camera());
         super::clip_gizmo::overlay(&ctx, free, &clip_gizmo, chosen, camera);
-        super::slice_views::planes_overlay(&ctx, free, &slice_views, chosen, camera);
+        let all_rulers: Vec<crate::slices::ruler::Ruler> = rulers.iter().copied().collect();
+        super::slice_views::planes_overlay(&ctx, free, &slice_views, chosen, camera, &all_rulers);
     }
     if let Ok((orbit, ..)) = cams.single() {
         window_menu(&ctx, free, &mut window_params, &datasets, orbit, &regions);
@@ -310,6 +316,7 @@ pub fn ui(
                 let mut saved: Vec<Entity> = datasets.iter().filter(|(_, _, _, o, _)| o.is_some()).map(|(e, ..)| e).collect();
                 saved.sort();
                 let windows = window_params.specs(&saved);
+                let rulers: Vec<_> = rulers.iter().filter_map(|r| crate::slices::ruler::RulerSpec::of(r, &saved)).collect();
                 let result = save_scene(
                     &path,
                     &ds_states(&datasets),
@@ -321,7 +328,7 @@ pub fn ui(
                         rendering: crate::scene::file::RenderingSpec::of(&state.view),
                     },
                     &session,
-                    windows,
+                    (windows, rulers),
                     &explode_specs,
                 );
                 if let Err(e) = result {
@@ -581,7 +588,7 @@ fn save_scene(
     rows: &[DatasetRow],
     view: ViewState,
     session: &Session,
-    windows: crate::windows::spec::WindowScene,
+    (windows, rulers): (crate::windows::spec::WindowScene, Vec<crate::slices::ruler::RulerSpec>),
     explode: &crate::explode::edit::CurrentSpecs,
 ) -> Result<(), String> {
     use crate::scene::save::{DatasetState, scene_file};
@@ -605,6 +612,7 @@ fn save_scene(
     scene.windows = windows.windows;
     scene.pointer = windows.pointer;
     scene.markers = windows.markers;
+    scene.rulers = rulers;
     let path = if path.extension().is_some_and(|e| e == "ron") { path.to_path_buf() } else { path.with_extension("ron") };
     std::fs::write(&path, scene.to_ron()?).map_err(|e| format!("{}: {e}", path.display()))
 }

@@ -2,8 +2,9 @@
 //! sagittal slices of the selected dataset at its voxels' resolution, linked by one
 //! crosshair (`slices::crosshair`), with window/level (right drag, presets, auto) and a
 //! label dataset laid over in its colours. Click or drag in a slice: the crosshair
-//! moves there; wheel: the next or previous slice; the value under the cursor shows
-//! below. The 3D view shows the three planes' outlines.
+//! moves there; wheel: the next or previous slice; Shift+click twice: a distance ruler
+//! (`slices::ruler`); the value under the cursor shows in the 3D view's corner. The 3D
+//! view shows the three planes' outlines and the rulers.
 
 use std::sync::Arc;
 
@@ -11,6 +12,7 @@ use bevy::prelude::*;
 use bevy_egui::egui::{self, Color32, Rect, Stroke, pos2};
 
 use crate::dataset::Dataset;
+use crate::slices::ruler::{self, Ruler};
 use crate::slices::{CT_PRESETS, Orientation, Slice, SliceAxes, WindowLevel, crosshair, outline, overlay_labels};
 use crate::volume::Volume;
 
@@ -22,6 +24,9 @@ pub fn colour(o: Orientation) -> Color32 {
         Orientation::Sagittal => Color32::from_rgb(240, 220, 80),
     }
 }
+
+/// The rulers' colour.
+const RULER: Color32 = Color32::from_rgb(255, 80, 220);
 
 /// The colour of the windows' outlines on the slices.
 const WINDOW_OUTLINE: Color32 = Color32::from_rgb(90, 200, 255);
@@ -41,6 +46,11 @@ pub struct SliceViews {
     pub overlay: bool,
     /// The value under the cursor, for the status line.
     pub probe: Option<String>,
+    /// A ruler's first end, placed (dataset, point in its frame).
+    pub ruler_start: Option<(Entity, Vec3)>,
+    /// Rulers made this frame, and a dataset whose rulers go ([`apply_rulers`]).
+    pub pending: Vec<Ruler>,
+    pub clear_rulers: Option<Entity>,
     pictures: [Option<Picture>; 3],
 }
 
@@ -74,7 +84,14 @@ pub type Shown<'a> = (Entity, &'a Dataset, &'a Transform);
 /// The panel under the 3D view (`root`'s bottom), for dataset `shown`; `labels` a label
 /// dataset to lay over; `boxes` the volumetric windows' boxes (world corners) to
 /// outline where a slice passes through them.
-pub fn panel(root: &mut egui::Ui, views: &mut SliceViews, shown: Option<Shown>, labels: Option<Shown>, boxes: &[[Vec3; 8]]) {
+pub fn panel(
+    root: &mut egui::Ui,
+    views: &mut SliceViews,
+    shown: Option<Shown>,
+    labels: Option<Shown>,
+    boxes: &[[Vec3; 8]],
+    rulers: &[Ruler],
+) {
     if !views.show {
         return;
     }
@@ -116,6 +133,16 @@ pub fn panel(root: &mut egui::Ui, views: &mut SliceViews, shown: Option<Shown>, 
                     views.window = Some((entity, w));
                 }
             }
+            let mine: Vec<Ruler> = rulers.iter().copied().filter(|r| r.dataset == entity).collect();
+            ui.separator();
+            if views.ruler_start.is_some_and(|(e, _)| e == entity) {
+                ui.label(egui::RichText::new("ruler: Shift+click its other end (Esc: cancel)").color(RULER));
+            } else {
+                ui.label(format!("rulers: {}", mine.len())).on_hover_text("Shift+click two points in the slices: a distance ruler");
+                if !mine.is_empty() && ui.small_button("clear").clicked() {
+                    views.clear_rulers = Some(entity);
+                }
+            }
             if labels.is_some() {
                 ui.separator();
                 ui.checkbox(&mut views.overlay, "Labels over").on_hover_text("Lay the label dataset over the slices in its colours");
@@ -127,7 +154,7 @@ pub fn panel(root: &mut egui::Ui, views: &mut SliceViews, shown: Option<Shown>, 
             for (k, o) in Orientation::ALL.into_iter().enumerate() {
                 ui.vertical(|ui| {
                     ui.set_width(cell.x);
-                    view(ui, views, k, o, (entity, dataset), point, window, labels.filter(|_| views.overlay), cell, &boxes);
+                    view(ui, views, k, o, (entity, dataset), point, window, labels.filter(|_| views.overlay), cell, (&boxes, rulers));
                 });
             }
         });
@@ -151,7 +178,7 @@ fn view(
     window: WindowLevel,
     overlay: Option<Shown>,
     cell: egui::Vec2,
-    boxes: &[[Vec3; 8]],
+    (boxes, rulers): (&[[Vec3; 8]], &[Ruler]),
 ) {
     let volume = &dataset.volume;
     let grid = &volume.grid;
@@ -216,9 +243,47 @@ fn view(
             painter.extend(egui::Shape::dashed_line(&outline, Stroke::new(1.5, WINDOW_OUTLINE), 6.0, 4.0));
         }
     }
+    // The rulers of this dataset where they pass through this slice, with their length.
+    let to_index = grid.world_to_index();
+    for r in rulers.iter().filter(|r| r.dataset == entity) {
+        let Some((s0, s1)) = ruler::on_slice(to_index.transform_point3(r.from), to_index.transform_point3(r.to), axes.normal, index) else {
+            continue;
+        };
+        let at = |s: f32| to_screen(crosshair::pixel_of(&axes, grid, r.from.lerp(r.to, s)));
+        let (a, b) = (at(s0), at(s1));
+        painter.line_segment([a, b], Stroke::new(2.0, RULER));
+        for (s, end) in [(0.0, a), (1.0, b)] {
+            if s >= s0 && s <= s1 {
+                painter.circle_filled(end, 3.0, RULER);
+            }
+        }
+        painter.text(
+            a.lerp(b, 0.5) + egui::vec2(4.0, -4.0),
+            egui::Align2::LEFT_BOTTOM,
+            format!("{:.1} mm", r.length_mm()),
+            egui::FontId::proportional(12.0),
+            RULER,
+        );
+    }
+    // A ruler begun follows the cursor.
+    if let Some((_, start)) = views.ruler_start.filter(|(e, _)| *e == entity)
+        && let Some(p) = response.hover_pos()
+    {
+        painter.line_segment([to_screen(crosshair::pixel_of(&axes, grid, start)), p], Stroke::new(1.0, RULER));
+    }
     painter.rect_stroke(rect, 0.0, Stroke::new(1.0, colour(o)), egui::StrokeKind::Inside);
-    // Interaction.
-    if (response.clicked() || response.dragged_by(egui::PointerButton::Primary))
+    // Interaction: Shift+click places a ruler's ends, a click or drag the crosshair.
+    let shift = ui.input(|i| i.modifiers.shift);
+    if response.clicked()
+        && shift
+        && let Some(p) = response.interact_pointer_pos()
+    {
+        let point = crosshair::point_at(&axes, grid, index, to_pixel(p));
+        match views.ruler_start.take() {
+            Some((e, from)) if e == entity => views.pending.push(Ruler { dataset: entity, from, to: point }),
+            _ => views.ruler_start = Some((entity, point)),
+        }
+    } else if (response.clicked() || response.dragged_by(egui::PointerButton::Primary))
         && let Some(p) = response.interact_pointer_pos()
     {
         views.crosshair = Some(crosshair::point_at(&axes, grid, index, to_pixel(p)));
@@ -258,8 +323,15 @@ fn probe(slice: &Slice, dataset: &Dataset, px: glam::Vec2) -> Option<String> {
 }
 
 /// The three planes' outlines in the 3D view (`free`), for the dataset shown.
-pub fn planes_overlay(ctx: &egui::Context, free: Rect, views: &SliceViews, shown: Option<Shown>, camera: Option<crate::region::Camera>) {
-    let (true, Some((_, dataset, transform)), Some(camera)) = (views.show, shown, camera) else { return };
+pub fn planes_overlay(
+    ctx: &egui::Context,
+    free: Rect,
+    views: &SliceViews,
+    shown: Option<Shown>,
+    camera: Option<crate::region::Camera>,
+    rulers: &[Ruler],
+) {
+    let (true, Some((entity, dataset, transform)), Some(camera)) = (views.show, shown, camera) else { return };
     let grid = &dataset.volume.grid;
     let point = views.crosshair.unwrap_or_else(|| grid.index_to_world().transform_point3((grid.dims.as_vec3() - 1.0) * 0.5));
     let painter = ctx.layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::new("slice_planes"))).with_clip_rect(free);
@@ -281,6 +353,24 @@ pub fn planes_overlay(ctx: &egui::Context, free: Rect, views: &SliceViews, shown
             painter.line(outline, Stroke::new(1.5, colour(o)));
         }
     }
+    // The rulers, with their length.
+    for r in rulers.iter().filter(|r| r.dataset == entity) {
+        let on_screen = |p: Vec3| {
+            camera.to_pixel(to_world.transform_point3(p), free.width(), free.height()).map(|q| pos2(free.left() + q.x, free.top() + q.y))
+        };
+        if let (Some(a), Some(b)) = (on_screen(r.from), on_screen(r.to)) {
+            painter.line_segment([a, b], Stroke::new(2.0, RULER));
+            painter.circle_filled(a, 3.0, RULER);
+            painter.circle_filled(b, 3.0, RULER);
+            painter.text(
+                a.lerp(b, 0.5) + egui::vec2(4.0, -4.0),
+                egui::Align2::LEFT_BOTTOM,
+                format!("{:.1} mm", r.length_mm()),
+                egui::FontId::proportional(13.0),
+                RULER,
+            );
+        }
+    }
     if let Some(text) = &views.probe {
         painter.text(free.left_top() + egui::vec2(8.0, 8.0), egui::Align2::LEFT_TOP, text, egui::FontId::monospace(13.0), Color32::WHITE);
     }
@@ -293,5 +383,28 @@ pub fn slice_keys(keys: Res<ButtonInput<KeyCode>>, mut contexts: bevy_egui::Egui
     }
     if keys.just_pressed(KeyCode::KeyL) {
         views.show = !views.show;
+    }
+}
+
+/// Spawns the rulers the views made and removes those the views cleared; Esc cancels a
+/// ruler begun.
+pub fn apply_rulers(
+    mut views: ResMut<SliceViews>,
+    mut commands: Commands,
+    rulers: Query<(Entity, &Ruler)>,
+    keys: Res<ButtonInput<KeyCode>>,
+) {
+    for r in std::mem::take(&mut views.pending) {
+        commands.spawn(r);
+    }
+    if let Some(dataset) = views.clear_rulers.take() {
+        for (e, r) in &rulers {
+            if r.dataset == dataset {
+                commands.entity(e).despawn();
+            }
+        }
+    }
+    if keys.just_pressed(KeyCode::Escape) {
+        views.ruler_start = None;
     }
 }
