@@ -406,3 +406,38 @@ fn the_app_shows_slice_views_of_the_data_under_the_3d_view() {
     let view = (h / 10..h / 2).flat_map(|y| (left..w).map(move |x| (x, y))).filter(|&(x, y)| img.get_pixel(x, y)[0] > 60).count();
     assert!(view > 2000, "the 3D view shows {view} lit pixels");
 }
+
+#[test]
+fn a_long_description_does_not_widen_the_panel() {
+    // A NIfTI-1 file with an 80-character description and a long name (MR_Gd-like).
+    let dir = scratch("app-long");
+    let mut h = vec![0u8; 352];
+    h[0..4].copy_from_slice(&348i32.to_le_bytes());
+    for (i, d) in [3i16, 32, 32, 32, 1, 1, 1, 1].iter().enumerate() {
+        h[40 + 2 * i..42 + 2 * i].copy_from_slice(&d.to_le_bytes());
+    }
+    h[70..72].copy_from_slice(&2i16.to_le_bytes()); // uint8
+    h[72..74].copy_from_slice(&8i16.to_le_bytes());
+    for (i, p) in [1.0f32, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0].iter().enumerate() {
+        h[76 + 4 * i..80 + 4 * i].copy_from_slice(&p.to_le_bytes());
+    }
+    h[108..112].copy_from_slice(&352f32.to_le_bytes());
+    h[112..116].copy_from_slice(&1f32.to_le_bytes());
+    let description = "Gd-enhanced T1 MPRAGE 3D sagittal 1mm iso TR2300 TE2.98 TI900 FA9 GRAPPA2 v2.1";
+    h[148..148 + description.len()].copy_from_slice(description.as_bytes());
+    h[344..348].copy_from_slice(b"n+1\0");
+    // A bright ball in the middle.
+    let voxels: Vec<u8> = (0..32 * 32 * 32)
+        .map(|n: i32| {
+            let (x, y, z) = (n % 32 - 16, n / 32 % 32 - 16, n / 1024 - 16);
+            if x * x + y * y + z * z < 100 { 200 } else { 0 }
+        })
+        .collect();
+    h.extend(voxels);
+    let file = dir.join("sub-01_ses-baseline_acq-MPRAGEgadolinium_run-01_T1w_defaced_resampled.nii");
+    std::fs::write(&file, h).unwrap();
+    let img = app_screenshot(&file, 4, &dir.join("long.png"));
+    let (w, _) = img.dimensions();
+    let left = viewport_left(&img).unwrap_or(w);
+    assert!(left < w * 45 / 100, "the panel takes {left} of {w} pixels");
+}

@@ -144,13 +144,17 @@ pub fn ui(
     let mut ds: Vec<_> = datasets.iter_mut().collect();
     ds.sort_by_key(|(e, ..)| *e);
     let selected = state.selected.min(ds.len().saturating_sub(1));
-    egui::Panel::left("controls").resizable(true).default_size(330.0).show(&mut root, |ui| {
+    // Resizable, at most two fifths of the window: long values wrap inside it.
+    let widest = (ctx.viewport_rect().width() * 0.4).max(240.0);
+    egui::Panel::left("controls").resizable(true).default_size(330.0_f32.min(widest)).max_size(widest).show(&mut root, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| {
             egui::CollapsingHeader::new("Data").default_open(true).show(ui, |ui| {
                 for (i, (_, d, gpu, _, _)) in ds.iter_mut().enumerate() {
                     ui.horizontal(|ui| {
                         ui.checkbox(&mut d.visible, "");
-                        if ui.selectable_label(i == selected, &d.volume.name).clicked() {
+                        // (Long names are cut to the panel, whole on hover.)
+                        let name = egui::Button::selectable(i == selected, &d.volume.name).truncate();
+                        if ui.add(name).on_hover_text(&d.volume.name).clicked() {
                             state.selected = i;
                         }
                     });
@@ -348,10 +352,12 @@ fn dataset_info(ui: &mut Ui, d: &Dataset) {
     let v = &d.volume;
     let g = &v.grid;
     let units = v.values.units.clone().map(|u| format!(" {u}")).unwrap_or_default();
-    egui::Grid::new("info").num_columns(2).show(ui, |ui| {
+    // (Values wrap: a long description or path must not widen the panel.)
+    let width = ui.available_width();
+    egui::Grid::new("info").num_columns(2).max_col_width((width - 90.0).max(80.0)).show(ui, |ui| {
         let mut row = |k: &str, val: String| {
             ui.label(RichText::new(k).weak());
-            ui.label(val);
+            ui.add(egui::Label::new(val).wrap());
             ui.end_row();
         };
         row("format", format!("{} ({})", v.source.format, v.source.sample_type));
