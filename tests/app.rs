@@ -105,6 +105,22 @@ fn the_app_opens_a_window_and_shows_the_phantom() {
     assert!(warm > 2000, "only {warm} phantom-coloured pixels");
 }
 
+/// The app's screenshot of `scene` with `options` after 4 frames (in Xvfb, 900×600).
+fn app_screenshot_with(scene: &std::path::Path, options: &[&str], shot: &std::path::Path) -> image::RgbaImage {
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_focal"))
+        .arg(scene)
+        .args(options)
+        .args(["--frames", "4", "--window", "900x600", "--screenshot"])
+        .arg(shot)
+        .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    image::open(shot).unwrap().to_rgba8()
+}
+
 /// The app's screenshot of `scene` after `frames` frames (in Xvfb).
 fn app_screenshot(scene: &std::path::Path, frames: u32, shot: &std::path::Path) -> image::RgbaImage {
     let out = Command::new("xvfb-run")
@@ -372,17 +388,7 @@ fn the_app_shows_slice_views_of_the_data_under_the_3d_view() {
         data("mri/ch2.nii.gz")
     );
     std::fs::write(&scene, text).unwrap();
-    let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1024x768x24"])
-        .arg(env!("CARGO_BIN_EXE_focal"))
-        .arg(&scene)
-        .args(["--slices", "--frames", "4", "--window", "900x600", "--screenshot"])
-        .arg(&shot)
-        .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let img = image::open(&shot).unwrap().to_rgba8();
+    let img = app_screenshot_with(&scene, &["--slices"], &shot);
     let (w, h) = img.dimensions();
     // Under the 3D view, right of the side panel: the three slices (MRI greys, the brain
     // bright), each framed in its view's colour with the crosshair's lines.
@@ -405,6 +411,21 @@ fn the_app_shows_slice_views_of_the_data_under_the_3d_view() {
     // The 3D view is still drawn above them.
     let view = (h / 10..h / 2).flat_map(|y| (left..w).map(move |x| (x, y))).filter(|&(x, y)| img.get_pixel(x, y)[0] > 60).count();
     assert!(view > 2000, "the 3D view shows {view} lit pixels");
+
+    // The atlas over its MRI (the label volume is the scene's selected dataset): the
+    // slices show the MRI's greys with the labels' colours over them.
+    let shot = dir.join("atlas.png");
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/ch2_aal.ron");
+    let img = app_screenshot_with(&scene, &["--slices"], &shot);
+    let (w, h) = img.dimensions();
+    let left = viewport_left(&img).unwrap_or(w / 3);
+    let count = |f: &dyn Fn(&image::Rgba<u8>) -> bool| {
+        (h * 6 / 10..h).flat_map(|y| (left..w).map(move |x| (x, y))).filter(|&(x, y)| f(img.get_pixel(x, y))).count()
+    };
+    let greys = count(&|p| p[0] == p[1] && p[1] == p[2] && p[0] > 90);
+    let coloured = count(&|p| p.0[..3].iter().max().unwrap() - p.0[..3].iter().min().unwrap() > 60);
+    println!("atlas over MRI: {greys} greys, {coloured} coloured pixels");
+    assert!(greys > 2000 && coloured > 2000, "{greys} greys, {coloured} coloured pixels in {}", shot.display());
 }
 
 #[test]

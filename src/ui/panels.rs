@@ -242,10 +242,18 @@ pub fn ui(
 
     // The slice views of the selected dataset under the 3D view, with a label dataset
     // to lay over them.
+    let slice_base;
     {
         let mut rows: Vec<_> = datasets.iter().map(|(e, d, _, _, t)| (e, d, t)).collect();
         rows.sort_by_key(|(e, ..)| *e);
-        let shown = rows.get(state.selected.min(rows.len().saturating_sub(1))).copied();
+        // (A label volume selected beside data: the data's slices with the labels over
+        // them, as an atlas over its MRI is read.)
+        let selected_row = rows.get(state.selected.min(rows.len().saturating_sub(1))).copied();
+        let shown = match selected_row {
+            Some(row) if row.1.labels.is_some() => rows.iter().copied().find(|(_, d, _)| d.labels.is_none()).or(Some(row)),
+            other => other,
+        };
+        slice_base = shown.map(|(e, ..)| e);
         let labels = rows.iter().copied().find(|(e, d, _)| d.labels.is_some() && shown.is_some_and(|s| s.0 != *e));
         let boxes: Vec<[Vec3; 8]> =
             window_params.windows.iter().map(|(_, w, g)| crate::windows::systems::window_box(w, g).corners()).collect();
@@ -268,7 +276,8 @@ pub fn ui(
         let camera = cams.single().ok().map(|(o, ..)| o.camera());
         super::clip_gizmo::overlay(&ctx, free, &clip_gizmo, chosen, camera);
         let all_rulers: Vec<crate::slices::ruler::Ruler> = rulers.iter().copied().collect();
-        super::slice_views::planes_overlay(&ctx, free, &slice_views, chosen, camera, &all_rulers);
+        let base = rows.iter().copied().find(|(e, ..)| Some(*e) == slice_base);
+        super::slice_views::planes_overlay(&ctx, free, &slice_views, base, camera, &all_rulers);
     }
     if let Ok((orbit, ..)) = cams.single() {
         window_menu(&ctx, free, &mut window_params, &datasets, orbit, &regions);

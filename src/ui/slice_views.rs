@@ -55,9 +55,9 @@ pub struct SliceViews {
 }
 
 impl SliceViews {
-    /// The views, shown or not.
+    /// The views, shown or not (a label dataset laid over them).
     pub fn shown(show: bool) -> SliceViews {
-        SliceViews { show, ..Default::default() }
+        SliceViews { show, overlay: true, ..Default::default() }
     }
 }
 
@@ -109,7 +109,7 @@ pub fn panel(
     let is_labels = dataset.labels.is_some();
     views.probe = None;
     egui::Panel::bottom("slice_views").resizable(true).default_size(280.0).min_size(120.0).show(root, |ui| {
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             ui.label(egui::RichText::new(format!("Slices of {}", volume.name)).strong());
             if !is_labels {
                 ui.separator();
@@ -148,8 +148,10 @@ pub fn panel(
                 ui.checkbox(&mut views.overlay, "Labels over").on_hover_text("Lay the label dataset over the slices in its colours");
             }
         });
+        // Three columns with the spacing between them.
         let room = ui.available_size();
-        let cell = egui::vec2((room.x - 16.0) / 3.0, room.y - 22.0);
+        let gap = ui.spacing().item_spacing.x;
+        let cell = egui::vec2(((room.x - 2.0 * gap) / 3.0 - 2.0).max(16.0), (room.y - 22.0).max(16.0));
         ui.horizontal(|ui| {
             for (k, o) in Orientation::ALL.into_iter().enumerate() {
                 ui.vertical(|ui| {
