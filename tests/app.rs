@@ -105,6 +105,12 @@ fn the_app_opens_a_window_and_shows_the_phantom() {
     assert!(warm > 2000, "only {warm} phantom-coloured pixels");
 }
 
+/// Pixels right of column `left` and below row `top` for which `f` holds.
+fn count_in(img: &image::RgbaImage, left: u32, top: u32, f: &dyn Fn(&image::Rgba<u8>) -> bool) -> usize {
+    let (w, h) = img.dimensions();
+    (top..h).flat_map(|y| (left..w).map(move |x| (x, y))).filter(|&(x, y)| f(img.get_pixel(x, y))).count()
+}
+
 /// The app's screenshot of `scene` with `options` after 4 frames (in Xvfb, 900×600).
 fn app_screenshot_with(scene: &std::path::Path, options: &[&str], shot: &std::path::Path) -> image::RgbaImage {
     let out = Command::new("xvfb-run")
@@ -393,9 +399,7 @@ fn the_app_shows_slice_views_of_the_data_under_the_3d_view() {
     // Under the 3D view, right of the side panel: the three slices (MRI greys, the brain
     // bright), each framed in its view's colour with the crosshair's lines.
     let left = viewport_left(&img).unwrap_or(w / 3);
-    let bottom = |f: &dyn Fn(&image::Rgba<u8>) -> bool| {
-        (h * 6 / 10..h).flat_map(|y| (left..w).map(move |x| (x, y))).filter(|&(x, y)| f(img.get_pixel(x, y))).count()
-    };
+    let bottom = |f: &dyn Fn(&image::Rgba<u8>) -> bool| count_in(&img, left, h * 6 / 10, f);
     let greys = bottom(&|p| p[0] == p[1] && p[1] == p[2] && p[0] > 90);
     let red = bottom(&|p| p[0] > 200 && p[1] < 110 && p[2] < 110);
     let green = bottom(&|p| p[1] > 180 && p[0] < 130 && p[2] < 130);
@@ -419,9 +423,7 @@ fn the_app_shows_slice_views_of_the_data_under_the_3d_view() {
     let img = app_screenshot_with(&scene, &["--slices"], &shot);
     let (w, h) = img.dimensions();
     let left = viewport_left(&img).unwrap_or(w / 3);
-    let count = |f: &dyn Fn(&image::Rgba<u8>) -> bool| {
-        (h * 6 / 10..h).flat_map(|y| (left..w).map(move |x| (x, y))).filter(|&(x, y)| f(img.get_pixel(x, y))).count()
-    };
+    let count = |f: &dyn Fn(&image::Rgba<u8>) -> bool| count_in(&img, left, h * 6 / 10, f);
     let greys = count(&|p| p[0] == p[1] && p[1] == p[2] && p[0] > 90);
     let coloured = count(&|p| p.0[..3].iter().max().unwrap() - p.0[..3].iter().min().unwrap() > 60);
     println!("atlas over MRI: {greys} greys, {coloured} coloured pixels");

@@ -243,6 +243,8 @@ pub fn ui(
     // The slice views of the selected dataset under the 3D view, with a label dataset
     // to lay over them.
     let slice_base;
+    // (The rulers, read once a frame for the slices and the 3D view.)
+    let all_rulers: Vec<crate::slices::ruler::Ruler> = if slice_views.show { rulers.iter().copied().collect() } else { Vec::new() };
     {
         let mut rows: Vec<_> = datasets.iter().map(|(e, d, _, _, t)| (e, d, t)).collect();
         rows.sort_by_key(|(e, ..)| *e);
@@ -255,9 +257,11 @@ pub fn ui(
         };
         slice_base = shown.map(|(e, ..)| e);
         let labels = rows.iter().copied().find(|(e, d, _)| d.labels.is_some() && shown.is_some_and(|s| s.0 != *e));
-        let boxes: Vec<[Vec3; 8]> =
-            window_params.windows.iter().map(|(_, w, g)| crate::windows::systems::window_box(w, g).corners()).collect();
-        let all_rulers: Vec<crate::slices::ruler::Ruler> = rulers.iter().copied().collect();
+        let boxes: Vec<[Vec3; 8]> = if slice_views.show {
+            window_params.windows.iter().map(|(_, w, g)| crate::windows::systems::window_box(w, g).corners()).collect()
+        } else {
+            Vec::new()
+        };
         super::slice_views::panel(&mut root, &mut slice_views, shown, labels, &boxes, &all_rulers);
     }
     // The rest of the window is the 3D viewport.
@@ -275,7 +279,6 @@ pub fn ui(
         let chosen = rows.get(state.selected.min(rows.len().saturating_sub(1))).copied();
         let camera = cams.single().ok().map(|(o, ..)| o.camera());
         super::clip_gizmo::overlay(&ctx, free, &clip_gizmo, chosen, camera);
-        let all_rulers: Vec<crate::slices::ruler::Ruler> = rulers.iter().copied().collect();
         let base = rows.iter().copied().find(|(e, ..)| Some(*e) == slice_base);
         super::slice_views::planes_overlay(&ctx, free, &slice_views, base, camera, &all_rulers);
     }

@@ -252,20 +252,7 @@ fn view(
             continue;
         };
         let at = |s: f32| to_screen(crosshair::pixel_of(&axes, grid, r.from.lerp(r.to, s)));
-        let (a, b) = (at(s0), at(s1));
-        painter.line_segment([a, b], Stroke::new(2.0, RULER));
-        for (s, end) in [(0.0, a), (1.0, b)] {
-            if s >= s0 && s <= s1 {
-                painter.circle_filled(end, 3.0, RULER);
-            }
-        }
-        painter.text(
-            a.lerp(b, 0.5) + egui::vec2(4.0, -4.0),
-            egui::Align2::LEFT_BOTTOM,
-            format!("{:.1} mm", r.length_mm()),
-            egui::FontId::proportional(12.0),
-            RULER,
-        );
+        draw_ruler(&painter, (at(s0), s0 == 0.0), (at(s1), s1 == 1.0), r.length_mm(), 12.0);
     }
     // A ruler begun follows the cursor.
     if let Some((_, start)) = views.ruler_start.filter(|(e, _)| *e == entity)
@@ -324,6 +311,19 @@ fn probe(slice: &Slice, dataset: &Dataset, px: glam::Vec2) -> Option<String> {
     })
 }
 
+/// A ruler from `a` to `b` on the screen (each with whether it is the ruler's end, which
+/// gets a dot), labelled with its length.
+fn draw_ruler(painter: &egui::Painter, (a, a_end): (egui::Pos2, bool), (b, b_end): (egui::Pos2, bool), length_mm: f32, font: f32) {
+    painter.line_segment([a, b], Stroke::new(2.0, RULER));
+    for (p, end) in [(a, a_end), (b, b_end)] {
+        if end {
+            painter.circle_filled(p, 3.0, RULER);
+        }
+    }
+    let label = format!("{length_mm:.1} mm");
+    painter.text(a.lerp(b, 0.5) + egui::vec2(4.0, -4.0), egui::Align2::LEFT_BOTTOM, label, egui::FontId::proportional(font), RULER);
+}
+
 /// The three planes' outlines in the 3D view (`free`), for the dataset shown.
 pub fn planes_overlay(
     ctx: &egui::Context,
@@ -361,16 +361,7 @@ pub fn planes_overlay(
             camera.to_pixel(to_world.transform_point3(p), free.width(), free.height()).map(|q| pos2(free.left() + q.x, free.top() + q.y))
         };
         if let (Some(a), Some(b)) = (on_screen(r.from), on_screen(r.to)) {
-            painter.line_segment([a, b], Stroke::new(2.0, RULER));
-            painter.circle_filled(a, 3.0, RULER);
-            painter.circle_filled(b, 3.0, RULER);
-            painter.text(
-                a.lerp(b, 0.5) + egui::vec2(4.0, -4.0),
-                egui::Align2::LEFT_BOTTOM,
-                format!("{:.1} mm", r.length_mm()),
-                egui::FontId::proportional(13.0),
-                RULER,
-            );
+            draw_ruler(&painter, (a, true), (b, true), r.length_mm(), 13.0);
         }
     }
     if let Some(text) = &views.probe {
