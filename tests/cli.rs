@@ -190,3 +190,40 @@ fn render_turntable_writes_an_orbit_as_pngs_and_a_gif() {
     assert_eq!(frames.len(), 4);
     assert_eq!(frames[0].buffer().dimensions(), (40, 32));
 }
+
+#[test]
+fn an_animated_scene_renders_its_keyframes_as_a_movie() {
+    let dir = scratch("cli-animation");
+    // Over 1 s at 2 frames a second: t = 0, 0.5, 1. Frame 1 is a quarter turn into a
+    // half orbit (90°) with κt half-way from 0 to 6 (3): the same picture as the still.
+    let scene = r#"(
+        size: (40, 32),
+        rendering: (jitter: false),
+        datasets: [(source: Phantom(kind: engine, resolution: 32), appearance: (mode: context))],
+        camera: Orbit(azimuth_deg: 0, elevation_deg: 20),
+        frames: [(name: "still", camera: Some(Orbit(azimuth_deg: 90, elevation_deg: 20)),
+                  set: [Context(dataset: 0, context: (kappa_t: 3.0, kappa_s: 0.5))])],
+        animation: Some((duration_s: 1, fps: 2, tracks: [
+            Camera(keys: [(t: 0, value: Orbit(azimuth_deg: 0, elevation_deg: 20)),
+                          (t: 1, value: Orbit(azimuth_deg: 180, elevation_deg: 20))], ease: linear),
+            KappaT(dataset: 0, keys: [(t: 0, value: 0), (t: 1, value: 6)], ease: linear),
+        ])),
+    )"#;
+    let path = dir.join("spin.ron");
+    std::fs::write(&path, scene).unwrap();
+    let out = focal().args(["render", "--cpu", "--out"]).arg(dir.join("out")).arg(&path).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let open = |p: &str| image::open(dir.join("out").join(p)).unwrap().to_rgba8();
+    assert_eq!(open("spin/spin-0001.png"), open("spin-still.png"));
+    assert_ne!(open("spin/spin-0000.png"), open("spin/spin-0001.png"));
+    assert_ne!(open("spin/spin-0001.png"), open("spin/spin-0002.png"));
+    use image::AnimationDecoder;
+    let gif = std::io::BufReader::new(std::fs::File::open(dir.join("out/spin/spin.gif")).unwrap());
+    let frames = image::codecs::gif::GifDecoder::new(gif).unwrap().into_frames().collect_frames().unwrap();
+    assert_eq!(frames.len(), 3);
+    // A key after the end is refused with the scene, the track and the key.
+    std::fs::write(&path, scene.replace("(t: 1, value: 6)", "(t: 2, value: 6)")).unwrap();
+    let out = focal().args(["render", "--cpu", "--out"]).arg(dir.join("out")).arg(&path).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("spin.ron") && err.contains("track 1 (KappaT): key 1"), "{err}");
+}

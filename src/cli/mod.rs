@@ -3,6 +3,5 @@
 pub mod bench;
 pub mod convert;
 pub mod info;
-pub mod movie;
 pub mod render;
 pub mod slice;

@@ -169,10 +169,11 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         return save(&image, &out);
     }
     if let Some(n) = args.turntable {
-        let scene = super::movie::turntable(scene, n, args.azimuth.unwrap_or(0.0), args.elevation.unwrap_or(20.0), args.ortho, args.zoom);
+        let scene =
+            focal::scene::movie::turntable(scene, n, args.azimuth.unwrap_or(0.0), args.elevation.unwrap_or(20.0), args.ortho, args.zoom);
         let frames = render_frames(scene, Path::new("."), &RunOptions { progress: true, ..options(PathBuf::new()) })?;
         let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("out/turntable"));
-        for p in super::movie::write(&frames, &dir)? {
+        for p in focal::scene::movie::write(&frames, &dir, "turntable", focal::scene::movie::FPS)? {
             println!("{}", p.display());
         }
         return Ok(());
@@ -240,6 +241,7 @@ fn scene_for(input: Option<&Path>, args: &RenderArgs) -> Result<SceneFile, Strin
         markers: Vec::new(),
         rulers: Vec::new(),
         frames: Vec::new(),
+        animation: None,
     })
 }
 

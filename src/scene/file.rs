@@ -78,6 +78,9 @@ pub struct SceneFile {
     /// Frames to capture; none means one frame of the scene as it is.
     #[serde(default)]
     pub frames: Vec<FrameSpec>,
+    /// Keyframed tracks rendered as a movie (see [`super::animation`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub animation: Option<super::animation::Animation>,
 }
 
 /// Ray-caster switches.
@@ -381,6 +384,9 @@ impl SceneFile {
         self.validate_windows(&self.windows)?;
         self.markers.iter().enumerate().try_for_each(|(i, m)| m.validate(i, self.datasets.len()))?;
         self.rulers.iter().enumerate().try_for_each(|(i, m)| m.validate(i, self.datasets.len()))?;
+        if let Some(a) = &self.animation {
+            a.validate(self)?;
+        }
         for frame in &self.frames {
             for change in &frame.set {
                 let checked = match change {

@@ -3,8 +3,10 @@
 //! parameter changes). `focal render SCENE.ron --out DIR` renders them headless
 //! ([`run`]); the app opens and saves them.
 
+pub mod animation;
 pub mod file;
 pub mod load;
+pub mod movie;
 pub mod run;
 pub mod save;
 

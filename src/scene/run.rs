@@ -41,17 +41,27 @@ fn slug(name: &str) -> String {
     name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
 }
 
-/// Renders every frame of the scene file at `path` into `options.out_dir`; returns the
-/// images written.
+/// Renders every frame of the scene file at `path` into `options.out_dir`, and its
+/// animation, if it has one, as a movie into the folder `<out_dir>/<scene>/`; returns
+/// the files written. A scene with an animation and no frames writes the movie only.
 pub fn render_scene_file(path: &Path, options: &RunOptions) -> Result<Vec<PathBuf>, String> {
     let scene = read_scene(path)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-    let images = render_frames(scene, &base, options).map_err(|e| format!("{}: {e}", path.display()))?;
-    std::fs::create_dir_all(&options.out_dir).map_err(|e| format!("{}: {e}", options.out_dir.display()))?;
+    let stem = slug(&path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into()));
+    let in_file = |e: String| format!("{}: {e}", path.display());
     let mut written = Vec::new();
+    if let Some(animation) = &scene.animation {
+        let movie = SceneFile { frames: animation.frames(&scene, &stem), animation: None, ..scene.clone() };
+        let images = render_frames(movie, &base, &RunOptions { progress: true, ..options.clone() }).map_err(in_file)?;
+        written.extend(super::movie::write(&images, &options.out_dir.join(&stem), &stem, animation.fps)?);
+        if scene.frames.is_empty() {
+            return Ok(written);
+        }
+    }
+    let images = render_frames(scene, &base, options).map_err(in_file)?;
+    std::fs::create_dir_all(&options.out_dir).map_err(|e| format!("{}: {e}", options.out_dir.display()))?;
     for (name, image) in images {
-        let out = options.out_dir.join(format!("{}-{}.png", slug(&stem), slug(&name)));
+        let out = options.out_dir.join(format!("{stem}-{}.png", slug(&name)));
         image.save(&out).map_err(|e| format!("{}: {e}", out.display()))?;
         written.push(out);
     }

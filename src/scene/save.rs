@@ -111,6 +111,7 @@ pub fn scene_file(
         markers: Vec::new(),
         rulers: Vec::new(),
         frames: Vec::new(),
+        animation: None,
     }
 }
 

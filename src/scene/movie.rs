@@ -1,14 +1,15 @@
-//! `focal render INPUT --turntable N --out DIR`: an orbit of N frames around the data,
-//! written as a PNG sequence (`turntable-0000.png` …), an animated GIF (`turntable.gif`,
-//! 25 frames a second, looping) and, where `ffmpeg` is on the PATH, an MP4
-//! (`turntable.mp4`, H.264 in yuv420p, as players expect).
+//! Movies: a scene's frames written as a PNG sequence (`NAME-0000.png` …), an animated
+//! GIF (`NAME.gif`, looping) and, where `ffmpeg` is on the PATH, an MP4 (`NAME.mp4`,
+//! H.264 in yuv420p, as players expect). They come from a scene's keyframed
+//! [`animation`](super::animation) or from `focal render INPUT --turntable N`, an orbit
+//! of N frames around the data.
 
 use std::path::{Path, PathBuf};
 
-use focal::scene::file::{CameraSpec, FrameSpec, SceneFile};
+use super::file::{CameraSpec, FrameSpec, SceneFile};
 
-/// Frames a second of the GIF and MP4.
-pub const FPS: u32 = 25;
+/// Frames a second of a turntable's GIF and MP4.
+pub const FPS: u32 = super::animation::DEFAULT_FPS;
 
 /// `scene` with `n` frames orbiting once about the superior axis from `azimuth_deg`, at
 /// `elevation_deg` (the first frame is the view at `azimuth_deg`; frame k is at
@@ -25,20 +26,20 @@ pub fn turntable(mut scene: SceneFile, n: u32, azimuth_deg: f32, elevation_deg: 
     scene
 }
 
-/// Writes the frames into `dir`: the PNG sequence, the GIF, the MP4 where ffmpeg is;
-/// returns what it wrote.
-pub fn write(frames: &[(String, image::RgbaImage)], dir: &Path) -> Result<Vec<PathBuf>, String> {
+/// Writes the frames (named `{name}-0000` …) into `dir` at `fps` frames a second: the
+/// PNG sequence, `{name}.gif`, `{name}.mp4` where ffmpeg is; returns what it wrote.
+pub fn write(frames: &[(String, image::RgbaImage)], dir: &Path, name: &str, fps: u32) -> Result<Vec<PathBuf>, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let mut written = Vec::new();
-    for (name, image) in frames {
-        let path = dir.join(format!("{name}.png"));
+    for (frame, image) in frames {
+        let path = dir.join(format!("{frame}.png"));
         image.save(&path).map_err(|e| format!("{}: {e}", path.display()))?;
         written.push(path);
     }
-    let gif = dir.join("turntable.gif");
-    write_gif(frames, &gif).map_err(|e| format!("{}: {e}", gif.display()))?;
+    let gif = dir.join(format!("{name}.gif"));
+    write_gif(frames, &gif, fps).map_err(|e| format!("{}: {e}", gif.display()))?;
     written.push(gif);
-    match write_mp4(dir) {
+    match write_mp4(dir, name, fps) {
         Ok(Some(mp4)) => written.push(mp4),
         Ok(None) => eprintln!("no ffmpeg on the PATH: no MP4 (the PNG sequence and the GIF are written)"),
         Err(e) => eprintln!("warning: the MP4 was not written: {e}"),
@@ -46,12 +47,12 @@ pub fn write(frames: &[(String, image::RgbaImage)], dir: &Path) -> Result<Vec<Pa
     Ok(written)
 }
 
-fn write_gif(frames: &[(String, image::RgbaImage)], path: &Path) -> Result<(), String> {
+fn write_gif(frames: &[(String, image::RgbaImage)], path: &Path, fps: u32) -> Result<(), String> {
     use image::codecs::gif::{GifEncoder, Repeat};
     let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
     let mut encoder = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
     encoder.set_repeat(Repeat::Infinite).map_err(|e| e.to_string())?;
-    let delay = image::Delay::from_numer_denom_ms(1000, FPS);
+    let delay = image::Delay::from_numer_denom_ms(1000, fps);
     for (k, (_, image)) in frames.iter().enumerate() {
         eprint!("\rGIF frame {}/{}", k + 1, frames.len());
         encoder.encode_frame(image::Frame::from_parts(image.clone(), 0, 0, delay)).map_err(|e| e.to_string())?;
@@ -60,15 +61,15 @@ fn write_gif(frames: &[(String, image::RgbaImage)], path: &Path) -> Result<(), S
     Ok(())
 }
 
-/// `turntable.mp4` from the PNG sequence with ffmpeg; `None` where there is none.
-fn write_mp4(dir: &Path) -> Result<Option<PathBuf>, String> {
+/// `{name}.mp4` from the PNG sequence with ffmpeg; `None` where there is none.
+fn write_mp4(dir: &Path, name: &str, fps: u32) -> Result<Option<PathBuf>, String> {
     if std::process::Command::new("ffmpeg").arg("-version").output().is_err() {
         return Ok(None);
     }
-    let mp4 = dir.join("turntable.mp4");
+    let mp4 = dir.join(format!("{name}.mp4"));
     let out = std::process::Command::new("ffmpeg")
-        .args(["-y", "-loglevel", "error", "-framerate", &FPS.to_string(), "-i"])
-        .arg(dir.join("turntable-%04d.png"))
+        .args(["-y", "-loglevel", "error", "-framerate", &fps.to_string(), "-i"])
+        .arg(dir.join(format!("{name}-%04d.png")))
         // (Even dimensions for yuv420p.)
         .args(["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p"])
         .arg(&mp4)
