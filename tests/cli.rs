@@ -227,3 +227,39 @@ fn an_animated_scene_renders_its_keyframes_as_a_movie() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("spin.ron") && err.contains("track 1 (KappaT): key 1"), "{err}");
 }
+
+#[test]
+fn the_apps_movie_job_records_a_scene_turntable_and_an_animation() {
+    use focal::ui::movie::{MovieJob, MovieKind, MovieStatus};
+    let dir = scratch("cli-movie-job");
+    let scene = dir.join("view.ron");
+    std::fs::write(
+        &scene,
+        r#"(datasets: [(source: Phantom(kind: engine, resolution: 24))],
+            animation: Some((duration_s: 1, fps: 3, tracks: [KappaT(dataset: 0, keys: [(t: 0, value: 0)])])))"#,
+    )
+    .unwrap();
+    let exe = std::path::Path::new(env!("CARGO_BIN_EXE_focal"));
+    let extra = ["--cpu".to_string(), "--size".into(), "32x24".into()];
+    let finish = |mut job: MovieJob| {
+        let start = std::time::Instant::now();
+        loop {
+            match job.poll() {
+                MovieStatus::Running(_) if start.elapsed().as_secs() < 120 => std::thread::sleep(std::time::Duration::from_millis(50)),
+                status => return status,
+            }
+        }
+    };
+    let turn = finish(MovieJob::start(exe, &scene, MovieKind::Turntable { frames: 3, elevation_deg: 10.0 }, &dir, &extra).unwrap());
+    assert_eq!(turn, MovieStatus::Done(dir.join("turntable.gif")));
+    assert!(dir.join("turntable-0002.png").exists());
+    let animated = finish(MovieJob::start(exe, &scene, MovieKind::Animation, &dir, &extra).unwrap());
+    assert_eq!(animated, MovieStatus::Done(dir.join("view/view.gif")));
+    assert!(dir.join("view/view-0003.png").exists(), "1 s at 3 fps: four frames");
+    // A scene that does not load: the job fails with the renderer's words.
+    std::fs::write(&scene, "(datasets: [(source: Phantom(kind: motorbike))])").unwrap();
+    match finish(MovieJob::start(exe, &scene, MovieKind::Animation, &dir, &extra).unwrap()) {
+        MovieStatus::Failed(e) => assert!(e.contains("view.ron") && e.contains("motorbike"), "{e}"),
+        other => panic!("{other:?}"),
+    }
+}

@@ -101,7 +101,8 @@ pub struct RenderArgs {
     /// Window centre (level) of a slice view, in the data's units (with --window).
     #[arg(long, requires = "window", allow_hyphen_values = true)]
     level: Option<f64>,
-    /// Write an orbit of N frames about the superior axis instead of one picture, from
+    /// Write an orbit of N frames about the superior axis instead of one picture (of the
+    /// data file or of one scene file), from
     /// --azimuth (default 0) at --elevation (default 20): a PNG sequence, an animated GIF
     /// and, where ffmpeg is installed, an MP4 in the --out folder (default `out/turntable`).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=3600), conflicts_with = "slice")]
@@ -146,6 +147,12 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         if scenes.len() != args.inputs.len() {
             return Err("give either scene files (.ron) or one data file, not both".into());
         }
+        if let Some(n) = args.turntable {
+            let [path] = scenes[..] else { return Err("--turntable takes one scene file".into()) };
+            let scene = focal::scene::read_scene(path)?;
+            let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+            return turntable(scene, n, &base, args, options(PathBuf::new())).map_err(|e| format!("{}: {e}", path.display()));
+        }
         let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("out"));
         for s in scenes {
             let t = std::time::Instant::now();
@@ -169,19 +176,25 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         return save(&image, &out);
     }
     if let Some(n) = args.turntable {
-        let scene =
-            focal::scene::movie::turntable(scene, n, args.azimuth.unwrap_or(0.0), args.elevation.unwrap_or(20.0), args.ortho, args.zoom);
-        let frames = render_frames(scene, Path::new("."), &RunOptions { progress: true, ..options(PathBuf::new()) })?;
-        let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("out/turntable"));
-        for p in focal::scene::movie::write(&frames, &dir, "turntable", focal::scene::movie::FPS)? {
-            println!("{}", p.display());
-        }
-        return Ok(());
+        return turntable(scene, n, Path::new("."), args, options(PathBuf::new()));
     }
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out/render.png"));
     let images = render_frames(scene, Path::new("."), &options(PathBuf::new()))?;
     let (_, image) = images.into_iter().next().ok_or("nothing rendered")?;
     save(&image, &out)
+}
+
+/// Renders an orbit of `n` frames around `scene` (relative paths from `base`) into the
+/// --out folder (default `out/turntable`).
+fn turntable(scene: SceneFile, n: u32, base: &Path, args: &RenderArgs, options: RunOptions) -> Result<(), String> {
+    use focal::scene::movie;
+    let scene = movie::turntable(scene, n, args.azimuth.unwrap_or(0.0), args.elevation.unwrap_or(20.0), args.ortho, args.zoom);
+    let frames = render_frames(scene, base, &RunOptions { progress: true, ..options })?;
+    let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("out/turntable"));
+    for p in movie::write(&frames, &dir, "turntable", movie::FPS)? {
+        println!("{}", p.display());
+    }
+    Ok(())
 }
 
 /// A one-dataset scene from the command-line options.

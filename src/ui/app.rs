@@ -46,6 +46,7 @@ impl Plugin for FocalAppPlugin {
             .init_resource::<explode_overlay::CutPreview>()
             .init_resource::<super::streaming_status::LevelUnderCursor>()
             .insert_resource(super::slice_views::SliceViews::shown(self.slices))
+            .init_resource::<super::movie::MovieRecorder>()
             .add_systems(
                 Startup,
                 move |mut commands: Commands, mut egui: ResMut<EguiGlobalSettings>, mut load: MessageWriter<LoadRequest>| {

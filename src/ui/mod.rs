@@ -17,6 +17,7 @@ pub mod explode_selection;
 pub mod explode_tools;
 pub mod lenses;
 pub mod loading;
+pub mod movie;
 pub mod objects_panel;
 pub mod orbit;
 pub mod panels;

@@ -87,10 +87,11 @@ pub fn ui(
     clip_gizmo: Res<super::clip_gizmo::ClipGizmo>,
     mut window_params: super::windows_panel::WindowParams,
     // (A tuple: a system takes at most 16 parameters.)
-    (explode_specs, mut slice_views, rulers): (
+    (explode_specs, mut slice_views, rulers, mut movie): (
         Res<crate::explode::edit::CurrentSpecs>,
         ResMut<super::slice_views::SliceViews>,
         Query<&crate::slices::ruler::Ruler>,
+        ResMut<super::movie::MovieRecorder>,
     ),
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
@@ -114,6 +115,9 @@ pub fn ui(
                 if ui.button("Save scene…  (Ctrl+S)").clicked() {
                     state.dialog_purpose = DialogPurpose::SaveScene;
                     state.dialog.save_file();
+                }
+                if ui.button("Record movie…").on_hover_text("A turntable or the scene's animation, as PNGs and a GIF").clicked() {
+                    movie.open = true;
                 }
                 if ui.button("Head phantom").clicked() {
                     load.write(LoadRequest::Scene(Box::new(default_scene()), Default::default()));
@@ -320,34 +324,45 @@ pub fn ui(
         }
     }
 
-    // File dialogs.
     state.dialog.update(&ctx);
-    if let Some(path) = state.dialog.take_picked() {
-        match state.dialog_purpose {
+    let picked = state.dialog.take_picked().map(|p| (p, state.dialog_purpose));
+    // Writes the view as it is now as a scene file.
+    let save = |path: &std::path::Path| {
+        // The saved datasets, in the order ds_states writes them.
+        let mut saved: Vec<Entity> = datasets.iter().filter(|(_, _, _, o, _)| o.is_some()).map(|(e, ..)| e).collect();
+        saved.sort();
+        let windows = window_params.specs(&saved);
+        let rulers: Vec<_> = rulers.iter().filter_map(|r| crate::slices::ruler::RulerSpec::of(r, &saved)).collect();
+        save_scene(
+            path,
+            &ds_states(&datasets),
+            ViewState {
+                camera: cams.single().map(|(o, ..)| o.camera()).ok(),
+                background: state.background,
+                light: light.0,
+                lenses: &lens_params.ordered().into_iter().map(|(_, l, _)| l).collect::<Vec<_>>(),
+                rendering: crate::scene::file::RenderingSpec::of(&state.view),
+            },
+            &session,
+            (windows, rulers),
+            &explode_specs,
+        )
+    };
+
+    // Movies.
+    let animation = session.scene.as_ref().and_then(|s| s.animation.as_ref()).map(|a| (a.duration_s, a.fps));
+    movie.window(&ctx, animation);
+    let aspect = cams.single().ok().and_then(|(_, c, _)| c.logical_viewport_size()).map(|s| s.x / s.y.max(1.0)).unwrap_or(1.0);
+    movie.start_requested(aspect, &save);
+
+    // File dialogs.
+    if let Some((path, purpose)) = picked {
+        match purpose {
             DialogPurpose::Open => {
                 load.write(LoadRequest::Path(path));
             }
             DialogPurpose::SaveScene => {
-                // The saved datasets, in the order ds_states writes them.
-                let mut saved: Vec<Entity> = datasets.iter().filter(|(_, _, _, o, _)| o.is_some()).map(|(e, ..)| e).collect();
-                saved.sort();
-                let windows = window_params.specs(&saved);
-                let rulers: Vec<_> = rulers.iter().filter_map(|r| crate::slices::ruler::RulerSpec::of(r, &saved)).collect();
-                let result = save_scene(
-                    &path,
-                    &ds_states(&datasets),
-                    ViewState {
-                        camera: cams.single().map(|(o, ..)| o.camera()).ok(),
-                        background: state.background,
-                        light: light.0,
-                        lenses: &lens_params.ordered().into_iter().map(|(_, l, _)| l).collect::<Vec<_>>(),
-                        rendering: crate::scene::file::RenderingSpec::of(&state.view),
-                    },
-                    &session,
-                    (windows, rulers),
-                    &explode_specs,
-                );
-                if let Err(e) = result {
+                if let Err(e) = save(&path) {
                     session.error = Some(e);
                 }
             }
@@ -631,6 +646,9 @@ fn save_scene(
     scene.pointer = windows.pointer;
     scene.markers = windows.markers;
     scene.rulers = rulers;
+    // The loaded scene's animation, while it still fits what the view has (its lenses
+    // and datasets).
+    scene.animation = session.scene.as_ref().and_then(|s| s.animation.clone()).filter(|a| a.validate(&scene).is_ok());
     let path = if path.extension().is_some_and(|e| e == "ron") { path.to_path_buf() } else { path.with_extension("ron") };
     std::fs::write(&path, scene.to_ron()?).map_err(|e| format!("{}: {e}", path.display()))
 }
