@@ -353,7 +353,7 @@ pub fn ui(
     let animation = session.scene.as_ref().and_then(|s| s.animation.as_ref()).map(|a| (a.duration_s, a.fps));
     movie.window(&ctx, animation);
     let aspect = cams.single().ok().and_then(|(_, c, _)| c.logical_viewport_size()).map(|s| s.x / s.y.max(1.0)).unwrap_or(1.0);
-    movie.start_requested(aspect, &save);
+    movie.start_requested(aspect, save);
 
     // File dialogs.
     if let Some((path, purpose)) = picked {
