@@ -10,12 +10,14 @@
 //! - [`image`]: a slice's voxels (from memory or a streamed source) and its picture;
 //! - [`crosshair`]: the point the views share, the slice and pixel that show it;
 //! - [`outline`]: where a box (a volumetric window) cuts a slice;
+//! - [`lens_outline`]: where a lens (the camera's rays through its outlines) cuts one;
 //! - [`ruler`]: distance rulers between two points of a dataset, saved with the scene.
 //!
 //! `focal render INPUT --slice axial[:INDEX]` writes one slice view as a PNG.
 
 pub mod crosshair;
 pub mod image;
+pub mod lens_outline;
 pub mod outline;
 pub mod plane;
 pub mod ruler;

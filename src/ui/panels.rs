@@ -261,12 +261,23 @@ pub fn ui(
         };
         slice_base = shown.map(|(e, ..)| e);
         let labels = rows.iter().copied().find(|(e, d, _)| d.labels.is_some() && shown.is_some_and(|s| s.0 != *e));
-        let boxes: Vec<[Vec3; 8]> = if slice_views.show {
-            window_params.windows.iter().map(|(_, w, g)| crate::windows::systems::window_box(w, g).corners()).collect()
-        } else {
-            Vec::new()
-        };
-        super::slice_views::panel(&mut root, &mut slice_views, shown, labels, &boxes, &all_rulers);
+        let mut cuts = super::slice_views::Cuts::default();
+        if slice_views.show {
+            cuts.boxes = window_params.windows.iter().map(|(_, w, g)| crate::windows::systems::window_box(w, g).corners()).collect();
+            // (The 3D view's size as last laid out: the lenses' units follow its aspect.)
+            if let Ok((orbit, camera, _)) = cams.single()
+                && let Some(size) = camera.logical_viewport_size()
+            {
+                let screen = crate::lens::Screen { width: size.x.max(1.0), height: size.y.max(1.0) };
+                let camera = orbit.camera();
+                cuts.lenses = lens_params
+                    .ordered()
+                    .iter()
+                    .filter_map(|(_, l, _)| crate::slices::lens_outline::LensRays::of(l, &camera, screen))
+                    .collect();
+            }
+        }
+        super::slice_views::panel(&mut root, &mut slice_views, shown, labels, &cuts, &all_rulers);
     }
     // The rest of the window is the 3D viewport.
     let free = root.available_rect_before_wrap();

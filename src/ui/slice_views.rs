@@ -12,6 +12,8 @@ use bevy::prelude::*;
 use bevy_egui::egui::{self, Color32, Rect, Stroke, pos2};
 
 use crate::dataset::Dataset;
+use crate::region::Ray;
+use crate::slices::lens_outline::{self, LensRays};
 use crate::slices::ruler::{self, Ruler};
 use crate::slices::{CT_PRESETS, Orientation, Slice, SliceAxes, WindowLevel, crosshair, outline, overlay_labels};
 use crate::volume::Volume;
@@ -28,6 +30,8 @@ pub fn colour(o: Orientation) -> Color32 {
 /// The rulers' colour.
 const RULER: Color32 = Color32::from_rgb(255, 80, 220);
 
+/// The colour of the lenses' outlines on the slices (as the 3D view draws them).
+const LENS_OUTLINE: Color32 = Color32::from_gray(225);
 /// The colour of the windows' outlines on the slices.
 const WINDOW_OUTLINE: Color32 = Color32::from_rgb(90, 200, 255);
 
@@ -81,24 +85,33 @@ struct Key {
 /// One dataset as the views need it: entity, component, transform.
 pub type Shown<'a> = (Entity, &'a Dataset, &'a Transform);
 
+/// What the slices outline where they cut it (world space): the volumetric windows'
+/// boxes (corners) and the lenses (the camera's rays through their outlines).
+#[derive(Default)]
+pub struct Cuts {
+    pub boxes: Vec<[Vec3; 8]>,
+    pub lenses: Vec<LensRays>,
+}
+
 /// The panel under the 3D view (`root`'s bottom), for dataset `shown`; `labels` a label
-/// dataset to lay over; `boxes` the volumetric windows' boxes (world corners) to
-/// outline where a slice passes through them.
-pub fn panel(
-    root: &mut egui::Ui,
-    views: &mut SliceViews,
-    shown: Option<Shown>,
-    labels: Option<Shown>,
-    boxes: &[[Vec3; 8]],
-    rulers: &[Ruler],
-) {
+/// dataset to lay over; `cuts` the windows and lenses to outline where a slice passes
+/// through them.
+pub fn panel(root: &mut egui::Ui, views: &mut SliceViews, shown: Option<Shown>, labels: Option<Shown>, cuts: &Cuts, rulers: &[Ruler]) {
     if !views.show {
         return;
     }
     let Some((entity, dataset, transform)) = shown else { return };
-    // The boxes in the dataset's frame.
+    // The windows and lenses in the dataset's frame.
     let to_dataset = transform.compute_affine().inverse();
-    let boxes: Vec<[Vec3; 8]> = boxes.iter().map(|b| b.map(|c| to_dataset.transform_point3(c))).collect();
+    let ray = |r: &Ray| Ray { origin: to_dataset.transform_point3(r.origin), dir: to_dataset.transform_vector3(r.dir) };
+    let cuts = Cuts {
+        boxes: cuts.boxes.iter().map(|b| b.map(|c| to_dataset.transform_point3(c))).collect(),
+        lenses: cuts
+            .lenses
+            .iter()
+            .map(|l| LensRays { rim: l.rim.iter().map(ray).collect(), outer: l.outer.iter().map(ray).collect() })
+            .collect(),
+    };
     let volume = &dataset.volume;
     let grid = &volume.grid;
     let point = views.crosshair.unwrap_or_else(|| grid.index_to_world().transform_point3((grid.dims.as_vec3() - 1.0) * 0.5));
@@ -156,7 +169,7 @@ pub fn panel(
             for (k, o) in Orientation::ALL.into_iter().enumerate() {
                 ui.vertical(|ui| {
                     ui.set_width(cell.x);
-                    view(ui, views, k, o, (entity, dataset), point, window, labels.filter(|_| views.overlay), cell, (&boxes, rulers));
+                    view(ui, views, k, o, (entity, dataset), point, window, labels.filter(|_| views.overlay), cell, (&cuts, rulers));
                 });
             }
         });
@@ -180,7 +193,7 @@ fn view(
     window: WindowLevel,
     overlay: Option<Shown>,
     cell: egui::Vec2,
-    (boxes, rulers): (&[[Vec3; 8]], &[Ruler]),
+    (cuts, rulers): (&Cuts, &[Ruler]),
 ) {
     let volume = &dataset.volume;
     let grid = &volume.grid;
@@ -238,15 +251,32 @@ fn view(
         painter.line_segment(line, Stroke::new(1.0, colour(other).gamma_multiply(0.8)));
     }
     // The windows this slice passes through, as the 3D view outlines them.
-    for b in boxes {
+    for b in &cuts.boxes {
         let mut outline: Vec<egui::Pos2> = outline::section(b, grid, &axes, index).into_iter().map(to_screen).collect();
         if let Some(&first) = outline.first() {
             outline.push(first);
             painter.extend(egui::Shape::dashed_line(&outline, Stroke::new(1.5, WINDOW_OUTLINE), 6.0, 4.0));
         }
     }
-    // The rulers of this dataset where they pass through this slice, with their length.
+    // The lenses, as the 3D view sees them through this slice: the focus rim solid, the
+    // border's outer edge dashed, each over a dark halo.
     let to_index = grid.world_to_index();
+    for lens in &cuts.lenses {
+        for (rays, dashed) in [(&lens.rim, false), (&lens.outer, true)] {
+            for curve in lens_outline::section(rays, to_index, grid, &axes, index) {
+                let points: Vec<egui::Pos2> = curve.into_iter().map(to_screen).collect();
+                let halo = Stroke::new(3.0, Color32::from_black_alpha(140));
+                let line = Stroke::new(1.2, LENS_OUTLINE);
+                if dashed {
+                    painter.extend(egui::Shape::dashed_line(&points, line, 6.0, 4.0));
+                } else {
+                    painter.add(egui::Shape::line(points.clone(), halo));
+                    painter.add(egui::Shape::line(points, line));
+                }
+            }
+        }
+    }
+    // The rulers of this dataset where they pass through this slice, with their length.
     for r in rulers.iter().filter(|r| r.dataset == entity) {
         let Some((s0, s1)) = ruler::on_slice(to_index.transform_point3(r.from), to_index.transform_point3(r.to), axes.normal, index) else {
             continue;
