@@ -70,6 +70,7 @@ impl Plugin for FocalAppPlugin {
                     shortcuts,
                     dropped_files,
                     centre_on_double_click,
+                    super::rulers::ruler_on_surface,
                     reframe,
                     sync_view,
                     automation,

@@ -21,6 +21,7 @@ pub mod movie;
 pub mod objects_panel;
 pub mod orbit;
 pub mod panels;
+pub mod rulers;
 pub mod slice_views;
 pub mod state;
 pub mod streaming_status;

@@ -248,7 +248,7 @@ pub fn ui(
     // to lay over them.
     let slice_base;
     // (The rulers, read once a frame for the slices and the 3D view.)
-    let all_rulers: Vec<crate::slices::ruler::Ruler> = if slice_views.show { rulers.iter().copied().collect() } else { Vec::new() };
+    let all_rulers: Vec<crate::slices::ruler::Ruler> = rulers.iter().copied().collect();
     {
         let mut rows: Vec<_> = datasets.iter().map(|(e, d, _, _, t)| (e, d, t)).collect();
         rows.sort_by_key(|(e, ..)| *e);
@@ -295,7 +295,15 @@ pub fn ui(
         let camera = cams.single().ok().map(|(o, ..)| o.camera());
         super::clip_gizmo::overlay(&ctx, free, &clip_gizmo, chosen, camera);
         let base = rows.iter().copied().find(|(e, ..)| Some(*e) == slice_base);
-        super::slice_views::planes_overlay(&ctx, free, &slice_views, base, camera, &all_rulers);
+        super::slice_views::planes_overlay(&ctx, free, &slice_views, base, camera);
+        let placed: Vec<_> = all_rulers
+            .iter()
+            .filter_map(|r| rows.iter().find(|(e, ..)| *e == r.dataset).map(|(_, _, t)| (*r, t.compute_affine())))
+            .collect();
+        let begun = slice_views
+            .ruler_start
+            .and_then(|(e, p)| rows.iter().find(|(d, ..)| *d == e).map(|(_, _, t)| t.compute_affine().transform_point3(p)));
+        super::rulers::overlay(&ctx, free, camera, &placed, begun);
     }
     if let Ok((orbit, ..)) = cams.single() {
         window_menu(&ctx, free, &mut window_params, &datasets, orbit, &regions);

@@ -11,6 +11,7 @@ use std::sync::Arc;
 use bevy::prelude::*;
 use bevy_egui::egui::{self, Color32, Rect, Stroke, pos2};
 
+use super::rulers::{RULER, draw_ruler};
 use crate::dataset::Dataset;
 use crate::region::Ray;
 use crate::slices::lens_outline::{self, LensRays};
@@ -26,9 +27,6 @@ pub fn colour(o: Orientation) -> Color32 {
         Orientation::Sagittal => Color32::from_rgb(240, 220, 80),
     }
 }
-
-/// The rulers' colour.
-const RULER: Color32 = Color32::from_rgb(255, 80, 220);
 
 /// The colour of the lenses' outlines on the slices (as the 3D view draws them).
 const LENS_OUTLINE: Color32 = Color32::from_gray(225);
@@ -59,6 +57,15 @@ pub struct SliceViews {
 }
 
 impl SliceViews {
+    /// A ruler's end at `point` of `dataset` (its frame): the first begins a ruler, the
+    /// second on the same dataset finishes it.
+    pub fn ruler_end(&mut self, dataset: Entity, point: Vec3) {
+        match self.ruler_start.take() {
+            Some((e, from)) if e == dataset => self.pending.push(Ruler { dataset, from, to: point }),
+            _ => self.ruler_start = Some((dataset, point)),
+        }
+    }
+
     /// The views, shown or not (a label dataset laid over them).
     pub fn shown(show: bool) -> SliceViews {
         SliceViews { show, overlay: true, ..Default::default() }
@@ -292,16 +299,14 @@ fn view(
     }
     painter.rect_stroke(rect, 0.0, Stroke::new(1.0, colour(o)), egui::StrokeKind::Inside);
     // Interaction: Shift+click places a ruler's ends, a click or drag the crosshair.
+    let mut ruler_end = None;
     let shift = ui.input(|i| i.modifiers.shift);
     if response.clicked()
         && shift
         && let Some(p) = response.interact_pointer_pos()
     {
         let point = crosshair::point_at(&axes, grid, index, to_pixel(p));
-        match views.ruler_start.take() {
-            Some((e, from)) if e == entity => views.pending.push(Ruler { dataset: entity, from, to: point }),
-            _ => views.ruler_start = Some((entity, point)),
-        }
+        ruler_end = Some(point);
     } else if (response.clicked() || response.dragged_by(egui::PointerButton::Primary))
         && let Some(p) = response.interact_pointer_pos()
     {
@@ -323,6 +328,9 @@ fn view(
         }
         views.probe = probe(&picture.slice, dataset, to_pixel(p));
     }
+    if let Some(point) = ruler_end {
+        views.ruler_end(entity, point);
+    }
 }
 
 /// The value (and label) of the voxel under continuous pixel `px`.
@@ -341,29 +349,9 @@ fn probe(slice: &Slice, dataset: &Dataset, px: glam::Vec2) -> Option<String> {
     })
 }
 
-/// A ruler from `a` to `b` on the screen (each with whether it is the ruler's end, which
-/// gets a dot), labelled with its length.
-fn draw_ruler(painter: &egui::Painter, (a, a_end): (egui::Pos2, bool), (b, b_end): (egui::Pos2, bool), length_mm: f32, font: f32) {
-    painter.line_segment([a, b], Stroke::new(2.0, RULER));
-    for (p, end) in [(a, a_end), (b, b_end)] {
-        if end {
-            painter.circle_filled(p, 3.0, RULER);
-        }
-    }
-    let label = format!("{length_mm:.1} mm");
-    painter.text(a.lerp(b, 0.5) + egui::vec2(4.0, -4.0), egui::Align2::LEFT_BOTTOM, label, egui::FontId::proportional(font), RULER);
-}
-
 /// The three planes' outlines in the 3D view (`free`), for the dataset shown.
-pub fn planes_overlay(
-    ctx: &egui::Context,
-    free: Rect,
-    views: &SliceViews,
-    shown: Option<Shown>,
-    camera: Option<crate::region::Camera>,
-    rulers: &[Ruler],
-) {
-    let (true, Some((entity, dataset, transform)), Some(camera)) = (views.show, shown, camera) else { return };
+pub fn planes_overlay(ctx: &egui::Context, free: Rect, views: &SliceViews, shown: Option<Shown>, camera: Option<crate::region::Camera>) {
+    let (true, Some((_, dataset, transform)), Some(camera)) = (views.show, shown, camera) else { return };
     let grid = &dataset.volume.grid;
     let point = views.crosshair.unwrap_or_else(|| grid.index_to_world().transform_point3((grid.dims.as_vec3() - 1.0) * 0.5));
     let painter = ctx.layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::new("slice_planes"))).with_clip_rect(free);
@@ -384,18 +372,6 @@ pub fn planes_overlay(
             outline.push(outline[0]);
             painter.line(outline, Stroke::new(1.5, colour(o)));
         }
-    }
-    // The rulers, with their length.
-    for r in rulers.iter().filter(|r| r.dataset == entity) {
-        let on_screen = |p: Vec3| {
-            camera.to_pixel(to_world.transform_point3(p), free.width(), free.height()).map(|q| pos2(free.left() + q.x, free.top() + q.y))
-        };
-        if let (Some(a), Some(b)) = (on_screen(r.from), on_screen(r.to)) {
-            draw_ruler(&painter, (a, true), (b, true), r.length_mm(), 13.0);
-        }
-    }
-    if let Some(text) = &views.probe {
-        painter.text(free.left_top() + egui::vec2(8.0, 8.0), egui::Align2::LEFT_TOP, text, egui::FontId::monospace(13.0), Color32::WHITE);
     }
 }
 

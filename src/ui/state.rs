@@ -37,6 +37,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("F12 or S", "save a screenshot (out/)"),
     ("F", "show the frame rate"),
     ("L", "slice views on / off (click: crosshair; wheel: slice; right drag: window/level)"),
+    ("Shift+click twice", "a distance ruler, on the surface in the 3D view or in a slice (Esc: cancel)"),
     ("H or F1", "this help"),
 ];
 
