@@ -92,6 +92,7 @@ fn the_app_opens_a_window_and_shows_the_phantom() {
         .args(["--frames", "4", "--window", "640x400", "--screenshot"])
         .arg(&shot)
         .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
+        .env("FOCAL_CONFIG_DIR", config_dir(&shot))
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -103,6 +104,11 @@ fn the_app_opens_a_window_and_shows_the_phantom() {
     assert!(panel[0] > 15 && panel[0] < 80, "panel {panel:?} in {}", shot.display());
     let warm = img.pixels().filter(|p| p[0] > 150 && p[0] as u32 > p[2] as u32 + 20).count();
     assert!(warm > 2000, "only {warm} phantom-coloured pixels");
+}
+
+/// The settings folder of an app run writing `shot` (beside it, never the user's own).
+fn config_dir(shot: &std::path::Path) -> std::path::PathBuf {
+    shot.parent().unwrap_or(std::path::Path::new(".")).join("config")
 }
 
 /// Pixels right of column `left` and below row `top` for which `f` holds.
@@ -121,6 +127,7 @@ fn app_screenshot_with(scene: &std::path::Path, options: &[&str], shot: &std::pa
         .args(["--frames", "4", "--window", "900x600", "--screenshot"])
         .arg(shot)
         .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
+        .env("FOCAL_CONFIG_DIR", config_dir(shot))
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -136,6 +143,7 @@ fn app_screenshot(scene: &std::path::Path, frames: u32, shot: &std::path::Path) 
         .args(["--frames", &frames.to_string(), "--window", "800x500", "--screenshot"])
         .arg(shot)
         .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
+        .env("FOCAL_CONFIG_DIR", config_dir(shot))
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -463,4 +471,33 @@ fn a_long_description_does_not_widen_the_panel() {
     let (w, _) = img.dimensions();
     let left = viewport_left(&img).unwrap_or(w);
     assert!(left < w * 45 / 100, "the panel takes {left} of {w} pixels");
+}
+
+#[test]
+fn the_app_remembers_its_panel_width_and_the_files_it_opened() {
+    let dir = scratch("app-settings");
+    let shot = dir.join("wide.png");
+    let config = config_dir(&shot);
+    std::fs::create_dir_all(&config).unwrap();
+    std::fs::write(config.join("settings.ron"), "(panel_width: Some(450.0))").unwrap();
+    let file = common::data("ct/fuel.nii.gz");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x800x24"])
+        .arg(env!("CARGO_BIN_EXE_focal"))
+        .arg(&file)
+        .args(["--frames", "2", "--window", "1200x700", "--screenshot"])
+        .arg(&shot)
+        .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
+        .env("FOCAL_CONFIG_DIR", &config)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&shot).unwrap().to_rgba8();
+    let left = viewport_left(&img).expect("the viewport's edge");
+    assert!((440..=462).contains(&left), "the panel is {left} px wide, not the 450 remembered ({})", shot.display());
+    // The file is the first recent one, the width still remembered.
+    let (settings, warning) = focal::ui::settings::Settings::read(&config.join("settings.ron"));
+    assert_eq!(warning, None);
+    assert_eq!(settings.recent.first(), Some(&std::fs::canonicalize(&file).unwrap()));
+    assert_eq!(settings.panel_width, Some(450.0));
 }

@@ -30,6 +30,8 @@ pub struct Session {
     pub error: Option<String>,
     /// Set when new data arrived: the camera should frame it.
     pub reframe: Option<Reframe>,
+    /// The file, folder or scene a load just opened (for the recent files).
+    pub opened: Option<PathBuf>,
 }
 
 /// How to place the camera on new data: the visible bounds, and a scene file's own
@@ -49,6 +51,8 @@ type Loaded = (SceneFile, PathBuf, Vec<LoadedDataset>, bool);
 #[derive(Component)]
 pub struct Loading {
     pub what: String,
+    /// The file, folder or scene being opened (none for a scene made in the app).
+    pub path: Option<PathBuf>,
     pub progress: Progress,
     task: Task<Result<Loaded, String>>,
 }
@@ -82,6 +86,10 @@ pub fn start_loads(mut commands: Commands, mut requests: MessageReader<LoadReque
     for request in requests.read() {
         let progress = Progress::default();
         let p = progress.clone();
+        let path = match request {
+            LoadRequest::Path(p) => Some(p.clone()),
+            LoadRequest::Scene(..) => None,
+        };
         let (what, job): (String, Box<dyn FnOnce() -> Result<Loaded, String> + Send>) = match request.clone() {
             LoadRequest::Path(path) => (
                 path.display().to_string(),
@@ -105,7 +113,7 @@ pub fn start_loads(mut commands: Commands, mut requests: MessageReader<LoadReque
             ),
         };
         let task = AsyncComputeTaskPool::get().spawn(async move { job() });
-        commands.spawn(Loading { what, progress, task });
+        commands.spawn(Loading { what, path, progress, task });
     }
 }
 
@@ -184,6 +192,7 @@ pub fn finish_loads(
                 session.scene = Some(scene);
                 session.base = base;
                 session.error = window_error;
+                session.opened = load.path.clone();
             }
             Err(e) => {
                 error!("{}: {e}", load.what);

@@ -22,6 +22,7 @@ pub mod objects_panel;
 pub mod orbit;
 pub mod panels;
 pub mod rulers;
+pub mod settings;
 pub mod slice_views;
 pub mod state;
 pub mod streaming_status;

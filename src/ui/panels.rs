@@ -66,6 +66,16 @@ fn window_menu(
 type DatasetQuery<'w, 's> =
     Query<'w, 's, (Entity, &'static mut Dataset, Option<&'static GpuVolume>, Option<&'static DatasetOrigin>, &'static Transform)>;
 
+/// More of what the panels read and edit (a tuple: a system takes at most 16
+/// parameters).
+type MoreParams<'w, 's> = (
+    Res<'w, crate::explode::edit::CurrentSpecs>,
+    ResMut<'w, super::slice_views::SliceViews>,
+    Query<'w, 's, &'static crate::slices::ruler::Ruler>,
+    ResMut<'w, super::movie::MovieRecorder>,
+    ResMut<'w, super::settings::Settings>,
+);
+
 /// Everything the panels read and edit.
 // A Bevy system: its parameters are the resources and queries it uses, and a query's
 // type names the components it reads; splitting them up would only hide that.
@@ -86,13 +96,7 @@ pub fn ui(
     mut lens_params: lenses::LensParams,
     clip_gizmo: Res<super::clip_gizmo::ClipGizmo>,
     mut window_params: super::windows_panel::WindowParams,
-    // (A tuple: a system takes at most 16 parameters.)
-    (explode_specs, mut slice_views, rulers, mut movie): (
-        Res<crate::explode::edit::CurrentSpecs>,
-        ResMut<super::slice_views::SliceViews>,
-        Query<&crate::slices::ruler::Ruler>,
-        ResMut<super::movie::MovieRecorder>,
-    ),
+    (explode_specs, mut slice_views, rulers, mut movie, mut settings): MoreParams,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(
@@ -112,6 +116,17 @@ pub fn ui(
                     state.dialog_purpose = DialogPurpose::Open;
                     state.dialog.pick_directory();
                 }
+                ui.menu_button("Open recent", |ui| {
+                    if settings.recent.is_empty() {
+                        ui.label("(nothing yet)");
+                    }
+                    for path in &settings.recent {
+                        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string());
+                        if ui.button(name).on_hover_text(path.display().to_string()).clicked() {
+                            load.write(LoadRequest::Path(path.clone()));
+                        }
+                    }
+                });
                 if ui.button("Save scene…  (Ctrl+S)").clicked() {
                     state.dialog_purpose = DialogPurpose::SaveScene;
                     state.dialog.save_file();
@@ -150,7 +165,8 @@ pub fn ui(
     let selected = state.selected.min(ds.len().saturating_sub(1));
     // Resizable, at most two fifths of the window: long values wrap inside it.
     let widest = (ctx.viewport_rect().width() * 0.4).max(240.0);
-    egui::Panel::left("controls").resizable(true).default_size(330.0_f32.min(widest)).max_size(widest).show(&mut root, |ui| {
+    let remembered = settings.panel_width.unwrap_or(DEFAULT_PANEL_WIDTH);
+    let panel = egui::Panel::left("controls").resizable(true).default_size(remembered.min(widest)).max_size(widest).show(&mut root, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| {
             egui::CollapsingHeader::new("Data").default_open(true).show(ui, |ui| {
                 for (i, (_, d, gpu, _, _)) in ds.iter_mut().enumerate() {
@@ -243,6 +259,11 @@ pub fn ui(
             });
         });
     });
+    // The width the user dragged the panel to, remembered once the drag is over.
+    let width = panel.response.rect.width();
+    if (width - remembered).abs() > 1.0 && width < widest - 1.0 && !ctx.input(|i| i.pointer.any_down()) {
+        settings.panel_width = Some(width);
+    }
 
     // The slice views of the selected dataset under the 3D view, with a label dataset
     // to lay over them.
@@ -624,6 +645,9 @@ fn ds_states<'a>(datasets: &'a DatasetQuery) -> Vec<DatasetRow<'a>> {
     rows.sort_by_key(|r| r.0);
     rows
 }
+
+/// The side panel's width (points) until the user drags it.
+const DEFAULT_PANEL_WIDTH: f32 = 330.0;
 
 /// What the view shows besides the datasets, for saving it.
 struct ViewState<'a> {
