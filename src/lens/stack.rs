@@ -188,6 +188,18 @@ pub fn local_magnification(camera: &Camera, screen: Screen, lenses: &[ResolvedLe
     (lensed > 0.0).then(|| (plain / lensed).sqrt())
 }
 
+/// Checks a view's lenses: at most [`MAX_LENSES`], each valid (named by its index
+/// and kind in the message).
+pub fn validate_lenses(lenses: &[Lens]) -> Result<(), String> {
+    if lenses.len() > MAX_LENSES {
+        return Err(format!("{} lenses, at most {} are supported per view", lenses.len(), MAX_LENSES));
+    }
+    for (i, l) in lenses.iter().enumerate() {
+        l.validate().map_err(|e| format!("lens {i} ({}): {e}", l.kind_name()))?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

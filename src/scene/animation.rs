@@ -22,13 +22,23 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::file::{CameraSpec, Change, FrameSpec, SceneFile};
+use super::camera::CameraSpec;
+use crate::context::ContextParams;
 use crate::lens::{Lens, LensKind};
 
 /// Frames a second unless the scene says otherwise.
 pub const DEFAULT_FPS: u32 = 25;
 /// The most frames one animation may have (a minute at 60 frames a second).
 pub const MAX_FRAMES: u32 = 3600;
+
+/// What an animation's tracks may refer to in their scene: its lenses, and for each
+/// dataset whether it is exploded and its context-preserving parameters.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Refers {
+    pub lenses: usize,
+    pub exploded: Vec<bool>,
+    pub contexts: Vec<ContextParams>,
+}
 
 /// A scene's animation: tracks of keys over `duration_s` seconds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -270,8 +280,8 @@ impl Track {
         }
     }
 
-    fn check(&self, scene: &SceneFile, duration: f32) -> Result<(), String> {
-        let n = scene.datasets.len();
+    fn check(&self, scene: &Refers, duration: f32) -> Result<(), String> {
+        let n = scene.exploded.len();
         let dataset = |d: usize| if d < n { Ok(()) } else { Err(format!("dataset {d}: the scene has {n}")) };
         match self {
             Track::Camera { keys, .. } => {
@@ -286,12 +296,12 @@ impl Track {
                 Ok(())
             }
             Track::Lens { lens, keys, .. } => {
-                if *lens >= scene.lenses.len() {
-                    return Err(format!("lens {lens}: the scene has {} (an animated lens must be in `lenses`)", scene.lenses.len()));
+                if *lens >= scene.lenses {
+                    return Err(format!("lens {lens}: the scene has {} (an animated lens must be in `lenses`)", scene.lenses));
                 }
                 check_keys(keys, duration)?;
                 let values: Vec<Lens> = keys.iter().map(|k| k.value.clone()).collect();
-                super::file::validate_lenses(&values)
+                crate::lens::stack::validate_lenses(&values)
             }
             Track::KappaT { dataset: d, keys, .. } => {
                 dataset(*d)?;
@@ -303,7 +313,7 @@ impl Track {
             }
             Track::Explosion { dataset: d, keys, .. } => {
                 dataset(*d)?;
-                if scene.datasets[*d].explode.is_none() {
+                if !scene.exploded[*d] {
                     return Err(format!("dataset {d} is not exploded (it has no explode)"));
                 }
                 check_keys(keys, duration)?;
@@ -324,7 +334,7 @@ impl Animation {
 
     /// Checks the animation against its scene: a duration, a frame rate, frames within
     /// [`MAX_FRAMES`], and every track's keys and references.
-    pub fn validate(&self, scene: &SceneFile) -> Result<(), String> {
+    pub fn validate(&self, scene: &Refers) -> Result<(), String> {
         let fail = |e: String| format!("animation: {e}");
         if !self.duration_s.is_finite() || self.duration_s <= 0.0 {
             return Err(fail(format!("duration_s {} is not a positive number of seconds", self.duration_s)));
@@ -341,49 +351,43 @@ impl Animation {
         Ok(())
     }
 
-    /// The animation as frames `{prefix}-0000` …: each frame's camera and the changes
-    /// that set every track's value at its time, with 1/fps s of simulation before it
-    /// when a dataset is exploded. Starts from `scene` as the file gives it.
-    pub fn frames(&self, scene: &SceneFile, prefix: &str) -> Vec<FrameSpec> {
-        let exploded = scene.datasets.iter().any(|d| d.explode.is_some());
-        let steps = if exploded { (crate::explode::ExplodeTiming::default().steps_per_second / self.fps as f32).round() as u32 } else { 0 };
-        (0..self.frame_count())
-            .map(|k| {
-                let t = k as f32 / self.fps as f32;
-                let mut camera = None;
-                let mut lenses = scene.lenses.clone();
-                let mut lenses_move = false;
-                let mut set = Vec::new();
-                for track in &self.tracks {
-                    match track {
-                        Track::Camera { keys, ease } => camera = Some(value_at(keys, *ease, t)),
-                        Track::Lens { lens, keys, ease } => {
-                            lenses[*lens] = value_at(keys, *ease, t);
-                            lenses_move = true;
-                        }
-                        Track::KappaT { dataset, keys, ease } => {
-                            let context = crate::context::ContextParams {
-                                kappa_t: value_at(keys, *ease, t),
-                                ..scene.datasets[*dataset].appearance.context
-                            };
-                            set.push(Change::Context { dataset: *dataset, context });
-                        }
-                        Track::Explosion { dataset, keys, ease } => set.push(Change::Explode {
-                            dataset: *dataset,
-                            degree: Some(value_at(keys, *ease, t)),
-                            viewing: None,
-                            deltas: None,
-                            fade: None,
-                        }),
-                    }
-                }
-                if lenses_move {
-                    set.push(Change::Lenses(lenses));
-                }
-                FrameSpec { name: format!("{prefix}-{k:04}"), camera, set, settle: Some(steps) }
-            })
-            .collect()
+    /// The time of frame `k`, seconds.
+    pub fn time_of(&self, k: u32) -> f32 {
+        k as f32 / self.fps as f32
     }
+
+    /// Every track's value at time `t` (the scene's `refers` gives what stays: the
+    /// lenses not animated, each dataset's other context parameters).
+    pub fn values_at(&self, t: f32, lenses: &[Lens], refers: &Refers) -> Values {
+        let mut values = Values::default();
+        for track in &self.tracks {
+            match track {
+                Track::Camera { keys, ease } => values.camera = Some(value_at(keys, *ease, t)),
+                Track::Lens { lens, keys, ease } => {
+                    let all = values.lenses.get_or_insert_with(|| lenses.to_vec());
+                    all[*lens] = value_at(keys, *ease, t);
+                }
+                Track::KappaT { dataset, keys, ease } => {
+                    let context = ContextParams { kappa_t: value_at(keys, *ease, t), ..refers.contexts[*dataset] };
+                    values.contexts.push((*dataset, context));
+                }
+                Track::Explosion { dataset, keys, ease } => values.degrees.push((*dataset, value_at(keys, *ease, t))),
+            }
+        }
+        values
+    }
+}
+
+/// The animated values at one time.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Values {
+    pub camera: Option<CameraSpec>,
+    /// The scene's lenses with the animated ones moved (`None`: no lens moves).
+    pub lenses: Option<Vec<Lens>>,
+    /// (dataset, its context-preserving parameters with κt animated).
+    pub contexts: Vec<(usize, ContextParams)>,
+    /// (dataset, its degree of explosion).
+    pub degrees: Vec<(usize, f32)>,
 }
 
 #[cfg(test)]
@@ -437,60 +441,54 @@ mod tests {
         }
     }
 
-    fn scene(text: &str) -> SceneFile {
-        SceneFile::parse(text, "test").unwrap()
+    fn animation(text: &str) -> Animation {
+        ron::from_str(text).unwrap()
     }
 
-    const ORBIT: &str = r#"(
-        datasets: [(source: Phantom(kind: head, resolution: 16), appearance: (mode: context))],
-        lenses: [(kind: magnifier(magnification: 2.0), center: (0.0, 0.0))],
-        animation: Some((duration_s: 2.0, fps: 4, tracks: [
-            Camera(keys: [(t: 0, value: Orbit(azimuth_deg: 0, elevation_deg: 10)),
-                          (t: 2, value: Orbit(azimuth_deg: 360, elevation_deg: 30, zoom: 2))], ease: linear),
-            Lens(lens: 0, keys: [(t: 0, value: (kind: magnifier(magnification: 2.0), center: (-0.5, 0.0))),
-                                 (t: 1, value: (kind: magnifier(magnification: 4.0), center: (0.5, 0.2), radius: 0.4))]),
-            KappaT(dataset: 0, keys: [(t: 0, value: 0), (t: 2, value: 6)], ease: linear),
-        ])),
-    )"#;
+    /// One dataset (context-preserving, not exploded), one lens.
+    fn refers() -> Refers {
+        Refers { lenses: 1, exploded: vec![false], contexts: vec![ContextParams { kappa_t: 0.0, kappa_s: 0.7, ..Default::default() }] }
+    }
+
+    const ORBIT: &str = r#"(duration_s: 2.0, fps: 4, tracks: [
+        Camera(keys: [(t: 0, value: Orbit(azimuth_deg: 0, elevation_deg: 10)),
+                      (t: 2, value: Orbit(azimuth_deg: 360, elevation_deg: 30, zoom: 2))], ease: linear),
+        Lens(lens: 0, keys: [(t: 0, value: (kind: magnifier(magnification: 2.0), center: (-0.5, 0.0))),
+                             (t: 1, value: (kind: magnifier(magnification: 4.0), center: (0.5, 0.2), radius: 0.4))]),
+        KappaT(dataset: 0, keys: [(t: 0, value: 0), (t: 2, value: 6)], ease: linear),
+    ])"#;
 
     #[test]
-    fn an_animation_becomes_frames_with_each_tracks_value() {
-        let s = scene(ORBIT);
-        let a = s.animation.clone().unwrap();
-        a.validate(&s).unwrap();
-        let frames = a.frames(&s, "movie");
-        assert_eq!(frames.len(), 9, "0, 0.25 … 2 s");
-        assert_eq!(frames[3].name, "movie-0003");
-        assert!(frames.iter().all(|f| f.settle == Some(0)), "nothing exploded: no simulation");
+    fn every_tracks_value_at_a_time() {
+        let a = animation(ORBIT);
+        a.validate(&refers()).unwrap();
+        assert_eq!(a.frame_count(), 9, "0, 0.25 … 2 s");
+        assert_eq!(a.time_of(2), 0.5);
+        let lens = Lens::magnifier(glam::Vec2::ZERO, 0.3, 0.15, 1.0);
+        let v = a.values_at(0.5, std::slice::from_ref(&lens), &refers());
         // t = 0.5 s: a quarter of the orbit, linear.
-        match frames[2].camera {
+        match v.camera {
             Some(CameraSpec::Orbit { azimuth_deg, elevation_deg, zoom, .. }) => {
                 assert_eq!((azimuth_deg, elevation_deg, zoom), (90.0, 15.0, 1.25));
             }
-            ref other => panic!("{other:?}"),
+            other => panic!("{other:?}"),
         }
-        // t = 0.5 s: the lens half-way (smooth: s = ½ gives ½), its radius 0.3 → 0.4.
-        let lens = frames[2].set.iter().find_map(|c| if let Change::Lenses(l) = c { Some(l[0].clone()) } else { None }).unwrap();
-        assert!((lens.center - glam::Vec2::new(0.0, 0.1)).length() < 1e-6);
-        assert!((lens.radius - 0.35).abs() < 1e-6);
+        // The lens half-way (smooth: s = ½ gives ½), its radius 0.3 → 0.4.
+        let moved = &v.lenses.unwrap()[0];
+        assert!((moved.center - glam::Vec2::new(0.0, 0.1)).length() < 1e-6);
+        assert!((moved.radius - 0.35).abs() < 1e-6);
         assert_eq!(
-            lens.kind,
+            moved.kind,
             LensKind::Magnifier { magnification: 3.0, profile: Default::default(), focus_depth: None, plane_depth: None }
         );
         // κt 0 → 6 linear: 1.5 at 0.5 s, the dataset's κs kept.
-        let context =
-            frames[2].set.iter().find_map(|c| if let Change::Context { context, .. } = c { Some(*context) } else { None }).unwrap();
-        assert_eq!(context.kappa_t, 1.5);
-        assert_eq!(context.kappa_s, s.datasets[0].appearance.context.kappa_s);
+        assert_eq!(v.contexts, vec![(0, ContextParams { kappa_t: 1.5, ..refers().contexts[0] })]);
+        assert!(v.degrees.is_empty());
     }
 
     #[test]
     fn bad_animations_are_refused_with_the_track_and_the_keys() {
-        let with = |tracks: &str| scene(&ORBIT.replace(ORBIT_TRACKS, tracks));
-        let err = |tracks: &str| {
-            let s = with(tracks);
-            s.animation.clone().unwrap().validate(&s).unwrap_err()
-        };
+        let err = |tracks: &str| animation(&ORBIT.replace(ORBIT_TRACKS, tracks)).validate(&refers()).unwrap_err();
         assert!(
             err("KappaT(dataset: 0, keys: [(t: 1, value: 0), (t: 0.5, value: 6)])").contains("(KappaT): keys 0 and 1: times must increase")
         );
@@ -501,8 +499,8 @@ mod tests {
         assert!(err("Explosion(dataset: 0, keys: [(t: 0, value: 1)])").contains("not exploded"));
         let mixed = "Camera(keys: [(t: 0, value: Orbit(azimuth_deg: 0, elevation_deg: 0)), (t: 1, value: View(view: left))])";
         assert!(err(mixed).contains("different kinds"));
-        let s = scene(&ORBIT.replace("duration_s: 2.0, fps: 4", "duration_s: 100.0, fps: 60"));
-        assert!(s.animation.clone().unwrap().validate(&s).unwrap_err().contains("more than 3600 frames"));
+        let long = animation(&ORBIT.replace("duration_s: 2.0, fps: 4", "duration_s: 100.0, fps: 60"));
+        assert!(long.validate(&refers()).unwrap_err().contains("more than 3600 frames"));
     }
 
     const ORBIT_TRACKS: &str = "KappaT(dataset: 0, keys: [(t: 0, value: 0), (t: 2, value: 6)], ease: linear),";

@@ -23,10 +23,13 @@ use std::path::PathBuf;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+pub use super::camera::CameraSpec;
+pub use crate::lens::stack::validate_lenses;
+
 use crate::clip::Clipping;
 use crate::context::ContextParams;
 
-use crate::region::{AppearanceSpec, Light, Mode, View};
+use crate::region::{AppearanceSpec, Light, Mode};
 use crate::transfer::TransferFunction;
 use crate::volume::phantom::Phantom;
 
@@ -209,59 +212,6 @@ fn is_unclipped(c: &Clipping) -> bool {
     *c == Clipping::default()
 }
 
-/// The camera.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub enum CameraSpec {
-    /// A standard view framing the visible data.
-    View {
-        view: View,
-        #[serde(default)]
-        orthographic: bool,
-        /// > 1 moves closer.
-        #[serde(default = "one")]
-        zoom: f32,
-    },
-    /// Azimuth and elevation around the visible data (see [`crate::region::Orbit`]).
-    Orbit {
-        azimuth_deg: f32,
-        elevation_deg: f32,
-        #[serde(default)]
-        orthographic: bool,
-        #[serde(default = "one")]
-        zoom: f32,
-    },
-    /// An explicit pose.
-    LookAt {
-        eye: (f32, f32, f32),
-        target: (f32, f32, f32),
-        #[serde(default = "z_up")]
-        up: (f32, f32, f32),
-        #[serde(default)]
-        orthographic_height: Option<f32>,
-        #[serde(default = "fov")]
-        fov_deg: f32,
-    },
-}
-
-fn one() -> f32 {
-    1.0
-}
-
-fn z_up() -> (f32, f32, f32) {
-    (0.0, 0.0, 1.0)
-}
-
-fn fov() -> f32 {
-    30.0
-}
-
-impl Default for CameraSpec {
-    fn default() -> Self {
-        CameraSpec::View { view: View::Oblique, orthographic: false, zoom: 1.0 }
-    }
-}
-
 /// One captured frame: an optional camera and changes applied before it (they stay).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -385,7 +335,7 @@ impl SceneFile {
         self.markers.iter().enumerate().try_for_each(|(i, m)| m.validate(i, self.datasets.len()))?;
         self.rulers.iter().enumerate().try_for_each(|(i, m)| m.validate(i, self.datasets.len()))?;
         if let Some(a) = &self.animation {
-            a.validate(self)?;
+            a.validate(&self.animation_refers())?;
         }
         for frame in &self.frames {
             for change in &frame.set {
@@ -418,6 +368,15 @@ impl SceneFile {
         windows.iter().enumerate().try_for_each(|(i, w)| w.validate(i, self.datasets.len(), windows.len()))
     }
 
+    /// What an animation of this scene may refer to.
+    pub fn animation_refers(&self) -> super::animation::Refers {
+        super::animation::Refers {
+            lenses: self.lenses.len(),
+            exploded: self.datasets.iter().map(|d| d.explode.is_some()).collect(),
+            contexts: self.datasets.iter().map(|d| d.appearance.context).collect(),
+        }
+    }
+
     /// Writes RON text.
     pub fn to_ron(&self) -> Result<String, String> {
         ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default()).map_err(|e| e.to_string())
@@ -426,17 +385,6 @@ impl SceneFile {
     pub fn background(&self) -> [f32; 3] {
         [self.background.0, self.background.1, self.background.2]
     }
-}
-
-/// Checks lenses; the message names the lens by its place in the list.
-pub fn validate_lenses(lenses: &[crate::lens::Lens]) -> Result<(), String> {
-    if lenses.len() > crate::lens::MAX_LENSES {
-        return Err(format!("{} lenses, at most {} are supported per view", lenses.len(), crate::lens::MAX_LENSES));
-    }
-    for (i, l) in lenses.iter().enumerate() {
-        l.validate().map_err(|e| format!("lens {i} ({}): {e}", l.kind_name()))?;
-    }
-    Ok(())
 }
 
 /// A tuple as a vector.

@@ -4,6 +4,7 @@
 //! ([`run`]); the app opens and saves them.
 
 pub mod animation;
+pub mod camera;
 pub mod file;
 pub mod load;
 pub mod movie;

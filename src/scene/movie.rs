@@ -6,7 +6,8 @@
 
 use std::path::{Path, PathBuf};
 
-use super::file::{CameraSpec, FrameSpec, SceneFile};
+use super::animation::Animation;
+use super::file::{CameraSpec, Change, FrameSpec, SceneFile};
 
 /// Frames a second of a turntable's GIF and MP4.
 pub const FPS: u32 = super::animation::DEFAULT_FPS;
@@ -24,6 +25,31 @@ pub fn turntable(mut scene: SceneFile, n: u32, azimuth_deg: f32, elevation_deg: 
         })
         .collect();
     scene
+}
+
+/// `scene`'s animation as frames `{prefix}-0000` …: each frame's camera and the changes
+/// that set every track's value at its time, with 1/fps s of simulation before it when
+/// a dataset is exploded. Starts from `scene` as the file gives it.
+pub fn animation_frames(animation: &Animation, scene: &SceneFile, prefix: &str) -> Vec<FrameSpec> {
+    let refers = scene.animation_refers();
+    let exploded = refers.exploded.iter().any(|x| *x);
+    let steps =
+        if exploded { (crate::explode::ExplodeTiming::default().steps_per_second / animation.fps as f32).round() as u32 } else { 0 };
+    (0..animation.frame_count())
+        .map(|k| {
+            let values = animation.values_at(animation.time_of(k), &scene.lenses, &refers);
+            let mut set: Vec<Change> = values.contexts.into_iter().map(|(dataset, context)| Change::Context { dataset, context }).collect();
+            set.extend(values.degrees.into_iter().map(|(dataset, d)| Change::Explode {
+                dataset,
+                degree: Some(d),
+                viewing: None,
+                deltas: None,
+                fade: None,
+            }));
+            set.extend(values.lenses.map(Change::Lenses));
+            FrameSpec { name: format!("{prefix}-{k:04}"), camera: values.camera, set, settle: Some(steps) }
+        })
+        .collect()
 }
 
 /// Writes the frames (named `{name}-0000` …) into `dir` at `fps` frames a second: the
@@ -102,5 +128,37 @@ mod tests {
             .collect();
         assert_eq!(azimuths, vec![30.0, 75.0, 120.0, 165.0, 210.0, 255.0, 300.0, 345.0]);
         assert_eq!(t.frames[3].name, "turntable-0003");
+    }
+
+    #[test]
+    fn an_animation_becomes_frames_with_each_tracks_changes() {
+        let scene = SceneFile::parse(
+            r#"(datasets: [(source: Phantom(kind: head, resolution: 16), appearance: (mode: context),
+                            explode: Some((selection: Range(lo: 100, hi: 200), parts: Grid((2, 1, 1)))))],
+                lenses: [(kind: magnifier(magnification: 2.0))],
+                animation: Some((duration_s: 1, fps: 12, tracks: [
+                    Explosion(dataset: 0, keys: [(t: 0, value: 0), (t: 1, value: 1)], ease: linear),
+                    KappaT(dataset: 0, keys: [(t: 0, value: 2)]),
+                ])))"#,
+            "test",
+        )
+        .unwrap();
+        scene.validate().unwrap();
+        let frames = animation_frames(scene.animation.as_ref().unwrap(), &scene, "clip");
+        assert_eq!(frames.len(), 13);
+        assert_eq!(frames[6].name, "clip-0006");
+        // Exploded: 1/12 s of simulation (10 steps of 1/120 s) before every frame.
+        assert!(frames.iter().all(|f| f.settle == Some(10)));
+        // Half-way: degree ½; κt 2 with the dataset's κs; no lens moves; no camera path.
+        assert!(frames[6].set.contains(&Change::Explode { dataset: 0, degree: Some(0.5), viewing: None, deltas: None, fade: None }));
+        let kappa_s = scene.datasets[0].appearance.context.kappa_s;
+        assert!(
+            frames[6]
+                .set
+                .iter()
+                .any(|c| matches!(c, Change::Context { context, .. } if context.kappa_t == 2.0 && context.kappa_s == kappa_s))
+        );
+        assert!(!frames[6].set.iter().any(|c| matches!(c, Change::Lenses(_))));
+        assert_eq!(frames[6].camera, None);
     }
 }

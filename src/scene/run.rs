@@ -51,7 +51,7 @@ pub fn render_scene_file(path: &Path, options: &RunOptions) -> Result<Vec<PathBu
     let in_file = |e: String| format!("{}: {e}", path.display());
     let mut written = Vec::new();
     if let Some(animation) = &scene.animation {
-        let movie = SceneFile { frames: animation.frames(&scene, &stem), animation: None, ..scene.clone() };
+        let movie = SceneFile { frames: super::movie::animation_frames(animation, &scene, &stem), animation: None, ..scene.clone() };
         let images = render_frames(movie, &base, &RunOptions { progress: true, ..options.clone() }).map_err(in_file)?;
         written.extend(super::movie::write(&images, &options.out_dir.join(&stem), &stem, animation.fps)?);
         if scene.frames.is_empty() {

@@ -47,6 +47,7 @@ impl Plugin for FocalAppPlugin {
             .init_resource::<super::streaming_status::LevelUnderCursor>()
             .insert_resource(super::slice_views::SliceViews::shown(self.slices))
             .init_resource::<super::movie::MovieRecorder>()
+            .init_resource::<super::rulers::RulerTool>()
             .insert_resource(super::settings::Settings::load())
             .add_systems(
                 Startup,
@@ -87,7 +88,7 @@ impl Plugin for FocalAppPlugin {
                     open_explode_panel,
                     super::streaming_status::level_under_cursor,
                     super::slice_views::slice_keys,
-                    super::slice_views::apply_rulers,
+                    super::rulers::apply_rulers,
                     (super::settings::remember_opened, super::settings::save_settings).chain(),
                 )
                     .after(orbit::apply_orbit),

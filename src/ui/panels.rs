@@ -74,6 +74,7 @@ type MoreParams<'w, 's> = (
     Query<'w, 's, &'static crate::slices::ruler::Ruler>,
     ResMut<'w, super::movie::MovieRecorder>,
     ResMut<'w, super::settings::Settings>,
+    ResMut<'w, super::rulers::RulerTool>,
 );
 
 /// Everything the panels read and edit.
@@ -96,7 +97,7 @@ pub fn ui(
     mut lens_params: lenses::LensParams,
     clip_gizmo: Res<super::clip_gizmo::ClipGizmo>,
     mut window_params: super::windows_panel::WindowParams,
-    (explode_specs, mut slice_views, rulers, mut movie, mut settings): MoreParams,
+    (explode_specs, mut slice_views, rulers, mut movie, mut settings, mut ruler_tool): MoreParams,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(
@@ -298,7 +299,7 @@ pub fn ui(
                     .collect();
             }
         }
-        super::slice_views::panel(&mut root, &mut slice_views, shown, labels, &cuts, &all_rulers);
+        super::slice_views::panel(&mut root, &mut slice_views, shown, labels, &cuts, (&all_rulers, &mut ruler_tool));
     }
     // The rest of the window is the 3D viewport.
     let free = root.available_rect_before_wrap();
@@ -321,9 +322,8 @@ pub fn ui(
             .iter()
             .filter_map(|r| rows.iter().find(|(e, ..)| *e == r.dataset).map(|(_, _, t)| (*r, t.compute_affine())))
             .collect();
-        let begun = slice_views
-            .ruler_start
-            .and_then(|(e, p)| rows.iter().find(|(d, ..)| *d == e).map(|(_, _, t)| t.compute_affine().transform_point3(p)));
+        let begun =
+            ruler_tool.start.and_then(|(e, p)| rows.iter().find(|(d, ..)| *d == e).map(|(_, _, t)| t.compute_affine().transform_point3(p)));
         super::rulers::overlay(&ctx, free, camera, &placed, begun);
     }
     if let Ok((orbit, ..)) = cams.single() {
@@ -691,7 +691,7 @@ fn save_scene(
     scene.rulers = rulers;
     // The loaded scene's animation, while it still fits what the view has (its lenses
     // and datasets).
-    scene.animation = session.scene.as_ref().and_then(|s| s.animation.clone()).filter(|a| a.validate(&scene).is_ok());
+    scene.animation = session.scene.as_ref().and_then(|s| s.animation.clone()).filter(|a| a.validate(&scene.animation_refers()).is_ok());
     let path = if path.extension().is_some_and(|e| e == "ron") { path.to_path_buf() } else { path.with_extension("ron") };
     std::fs::write(&path, scene.to_ron()?).map_err(|e| format!("{}: {e}", path.display()))
 }

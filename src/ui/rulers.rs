@@ -10,7 +10,6 @@ use bevy::window::PrimaryWindow;
 use bevy_egui::egui::{self, Color32, Rect, Stroke, pos2};
 
 use super::orbit::{OrbitCamera, PointerInViewport};
-use super::slice_views::SliceViews;
 use super::state::MainCamera;
 use super::viewport::viewport_logical;
 use crate::dataset::SceneRegions;
@@ -33,6 +32,44 @@ pub fn draw_ruler(painter: &egui::Painter, (a, a_end): (egui::Pos2, bool), (b, b
     }
     let label = format!("{length_mm:.1} mm");
     painter.text(a.lerp(b, 0.5) + egui::vec2(4.0, -4.0), egui::Align2::LEFT_BOTTOM, label, egui::FontId::proportional(font), RULER);
+}
+
+/// Rulers being made: the first end placed, rulers finished this frame, a dataset whose
+/// rulers go ([`apply_rulers`] spawns and despawns them).
+#[derive(Resource, Default)]
+pub struct RulerTool {
+    /// A ruler's first end (dataset, point in its frame).
+    pub start: Option<(Entity, Vec3)>,
+    pub pending: Vec<Ruler>,
+    pub clear: Option<Entity>,
+}
+
+impl RulerTool {
+    /// A ruler's end at `point` of `dataset` (its frame): the first begins a ruler, the
+    /// second on the same dataset finishes it.
+    pub fn end(&mut self, dataset: Entity, point: Vec3) {
+        match self.start.take() {
+            Some((e, from)) if e == dataset => self.pending.push(Ruler { dataset, from, to: point }),
+            _ => self.start = Some((dataset, point)),
+        }
+    }
+}
+
+/// Spawns the rulers made and removes those cleared; Esc cancels a ruler begun.
+pub fn apply_rulers(mut tool: ResMut<RulerTool>, mut commands: Commands, rulers: Query<(Entity, &Ruler)>, keys: Res<ButtonInput<KeyCode>>) {
+    for r in std::mem::take(&mut tool.pending) {
+        commands.spawn(r);
+    }
+    if let Some(dataset) = tool.clear.take() {
+        for (e, r) in &rulers {
+            if r.dataset == dataset {
+                commands.entity(e).despawn();
+            }
+        }
+    }
+    if keys.just_pressed(KeyCode::Escape) {
+        tool.start = None;
+    }
 }
 
 /// Every ruler in the 3D view (`free`), each with its dataset's placement, and a ruler
@@ -67,7 +104,7 @@ pub fn ruler_on_surface(
     pointer: Res<PointerInViewport>,
     regions: Res<SceneRegions>,
     cams: Query<(&OrbitCamera, &Camera), With<MainCamera>>,
-    mut views: ResMut<SliceViews>,
+    mut tool: ResMut<RulerTool>,
     mut pressed_at: Local<Option<Vec2>>,
 ) {
     let (Ok(window), Ok((orbit, camera))) = (windows.single(), cams.single()) else { return };
@@ -87,7 +124,7 @@ pub fn ruler_on_surface(
     let p = cursor - origin;
     let ray = orbit.camera().ray(p.x, p.y, size.x.max(1.0) as u32, size.y.max(1.0) as u32);
     if let Some((dataset, point)) = surface_point(&regions, ray) {
-        views.ruler_end(dataset, point);
+        tool.end(dataset, point);
     }
 }
 

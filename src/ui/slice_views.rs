@@ -11,7 +11,7 @@ use std::sync::Arc;
 use bevy::prelude::*;
 use bevy_egui::egui::{self, Color32, Rect, Stroke, pos2};
 
-use super::rulers::{RULER, draw_ruler};
+use super::rulers::{RULER, RulerTool, draw_ruler};
 use crate::dataset::Dataset;
 use crate::region::Ray;
 use crate::slices::lens_outline::{self, LensRays};
@@ -48,24 +48,10 @@ pub struct SliceViews {
     pub overlay: bool,
     /// The value under the cursor, for the status line.
     pub probe: Option<String>,
-    /// A ruler's first end, placed (dataset, point in its frame).
-    pub ruler_start: Option<(Entity, Vec3)>,
-    /// Rulers made this frame, and a dataset whose rulers go ([`apply_rulers`]).
-    pub pending: Vec<Ruler>,
-    pub clear_rulers: Option<Entity>,
     pictures: [Option<Picture>; 3],
 }
 
 impl SliceViews {
-    /// A ruler's end at `point` of `dataset` (its frame): the first begins a ruler, the
-    /// second on the same dataset finishes it.
-    pub fn ruler_end(&mut self, dataset: Entity, point: Vec3) {
-        match self.ruler_start.take() {
-            Some((e, from)) if e == dataset => self.pending.push(Ruler { dataset, from, to: point }),
-            _ => self.ruler_start = Some((dataset, point)),
-        }
-    }
-
     /// The views, shown or not (a label dataset laid over them).
     pub fn shown(show: bool) -> SliceViews {
         SliceViews { show, overlay: true, ..Default::default() }
@@ -103,7 +89,14 @@ pub struct Cuts {
 /// The panel under the 3D view (`root`'s bottom), for dataset `shown`; `labels` a label
 /// dataset to lay over; `cuts` the windows and lenses to outline where a slice passes
 /// through them.
-pub fn panel(root: &mut egui::Ui, views: &mut SliceViews, shown: Option<Shown>, labels: Option<Shown>, cuts: &Cuts, rulers: &[Ruler]) {
+pub fn panel(
+    root: &mut egui::Ui,
+    views: &mut SliceViews,
+    shown: Option<Shown>,
+    labels: Option<Shown>,
+    cuts: &Cuts,
+    (rulers, tool): (&[Ruler], &mut RulerTool),
+) {
     if !views.show {
         return;
     }
@@ -155,12 +148,12 @@ pub fn panel(root: &mut egui::Ui, views: &mut SliceViews, shown: Option<Shown>, 
             }
             let mine: Vec<Ruler> = rulers.iter().copied().filter(|r| r.dataset == entity).collect();
             ui.separator();
-            if views.ruler_start.is_some_and(|(e, _)| e == entity) {
+            if tool.start.is_some_and(|(e, _)| e == entity) {
                 ui.label(egui::RichText::new("ruler: Shift+click its other end (Esc: cancel)").color(RULER));
             } else {
                 ui.label(format!("rulers: {}", mine.len())).on_hover_text("Shift+click two points in the slices: a distance ruler");
                 if !mine.is_empty() && ui.small_button("clear").clicked() {
-                    views.clear_rulers = Some(entity);
+                    tool.clear = Some(entity);
                 }
             }
             if labels.is_some() {
@@ -176,7 +169,18 @@ pub fn panel(root: &mut egui::Ui, views: &mut SliceViews, shown: Option<Shown>, 
             for (k, o) in Orientation::ALL.into_iter().enumerate() {
                 ui.vertical(|ui| {
                     ui.set_width(cell.x);
-                    view(ui, views, k, o, (entity, dataset), point, window, labels.filter(|_| views.overlay), cell, (&cuts, rulers));
+                    view(
+                        ui,
+                        views,
+                        k,
+                        o,
+                        (entity, dataset),
+                        point,
+                        window,
+                        labels.filter(|_| views.overlay),
+                        cell,
+                        (&cuts, rulers, &mut *tool),
+                    );
                 });
             }
         });
@@ -200,7 +204,7 @@ fn view(
     window: WindowLevel,
     overlay: Option<Shown>,
     cell: egui::Vec2,
-    (cuts, rulers): (&Cuts, &[Ruler]),
+    (cuts, rulers, tool): (&Cuts, &[Ruler], &mut RulerTool),
 ) {
     let volume = &dataset.volume;
     let grid = &volume.grid;
@@ -292,7 +296,7 @@ fn view(
         draw_ruler(&painter, (at(s0), s0 == 0.0), (at(s1), s1 == 1.0), r.length_mm(), 12.0);
     }
     // A ruler begun follows the cursor.
-    if let Some((_, start)) = views.ruler_start.filter(|(e, _)| *e == entity)
+    if let Some((_, start)) = tool.start.filter(|(e, _)| *e == entity)
         && let Some(p) = response.hover_pos()
     {
         painter.line_segment([to_screen(crosshair::pixel_of(&axes, grid, start)), p], Stroke::new(1.0, RULER));
@@ -329,7 +333,7 @@ fn view(
         views.probe = probe(&picture.slice, dataset, to_pixel(p));
     }
     if let Some(point) = ruler_end {
-        views.ruler_end(entity, point);
+        tool.end(entity, point);
     }
 }
 
@@ -382,28 +386,5 @@ pub fn slice_keys(keys: Res<ButtonInput<KeyCode>>, mut contexts: bevy_egui::Egui
     }
     if keys.just_pressed(KeyCode::KeyL) {
         views.show = !views.show;
-    }
-}
-
-/// Spawns the rulers the views made and removes those the views cleared; Esc cancels a
-/// ruler begun.
-pub fn apply_rulers(
-    mut views: ResMut<SliceViews>,
-    mut commands: Commands,
-    rulers: Query<(Entity, &Ruler)>,
-    keys: Res<ButtonInput<KeyCode>>,
-) {
-    for r in std::mem::take(&mut views.pending) {
-        commands.spawn(r);
-    }
-    if let Some(dataset) = views.clear_rulers.take() {
-        for (e, r) in &rulers {
-            if r.dataset == dataset {
-                commands.entity(e).despawn();
-            }
-        }
-    }
-    if keys.just_pressed(KeyCode::Escape) {
-        views.ruler_start = None;
     }
 }
