@@ -501,3 +501,39 @@ fn the_app_remembers_its_panel_width_and_the_files_it_opened() {
     assert_eq!(settings.recent.first(), Some(&std::fs::canonicalize(&file).unwrap()));
     assert_eq!(settings.panel_width, Some(450.0));
 }
+
+#[test]
+fn the_slices_of_a_streamed_pyramid_show_its_native_voxels() {
+    // ch2 as an OME-Zarr pyramid (levels 181×217×181, 91×109×91, 46×55×46): the app
+    // keeps the 4 mm level in memory, the slice views read level 0's slices (1 mm).
+    let dir = scratch("app-streamed-slices");
+    let zarr = dir.join("ch2.ome.zarr");
+    let out = Command::new(env!("CARGO_BIN_EXE_focal"))
+        .arg("convert")
+        .arg(data("mri/ch2.nii.gz"))
+        .arg(&zarr)
+        .args(["--chunk", "64", "--force"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let shot = dir.join("slices.png");
+    let img = app_screenshot_with(&zarr, &["--slices"], &shot);
+    let (w, h) = img.dimensions();
+    let left = viewport_left(&img).unwrap_or(w / 3);
+    // Neighbouring grey pixels of the slices that are exactly equal: the 4 mm level
+    // magnified shows blocks (about three in four pairs equal), 1 mm voxels vary.
+    let grey = |p: &image::Rgba<u8>| p[0] == p[1] && p[1] == p[2] && p[0] > 60;
+    let (mut equal, mut pairs) = (0usize, 0usize);
+    for y in h * 6 / 10..h {
+        for x in left..w - 1 {
+            let (a, b) = (img.get_pixel(x, y), img.get_pixel(x + 1, y));
+            if grey(a) && grey(b) {
+                pairs += 1;
+                equal += usize::from(a == b);
+            }
+        }
+    }
+    println!("{equal} of {pairs} neighbouring grey pairs equal");
+    assert!(pairs > 5000, "the slices show little: {pairs} grey pairs in {}", shot.display());
+    assert!((equal as f64) < 0.45 * pairs as f64, "blocky slices: {equal} of {pairs} pairs equal in {}", shot.display());
+}

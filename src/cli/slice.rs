@@ -46,13 +46,8 @@ pub fn picture(
         Some(b) => {
             let source = b.cache.source();
             let levels = &source.info().levels;
-            let fits = |k: &usize| {
-                let axes = SliceAxes::of(levels[*k].grid.direction, orientation);
-                let (w, h) = axes.size(levels[*k].grid.dims);
-                w as u64 * h as u64 <= MAX_SLICE_PIXELS
-            };
-            let coarsest = levels.len().checked_sub(1).ok_or_else(|| format!("{}: the source has no levels", source.info().location()))?;
-            let level = (0..levels.len()).find(fits).unwrap_or(coarsest);
+            let level = focal::slices::image::finest_level_within(levels, orientation, MAX_SLICE_PIXELS)
+                .ok_or_else(|| format!("{}: the source has no levels", source.info().location()))?;
             let axes = SliceAxes::of(levels[level].grid.direction, orientation);
             let count0 = axes.count(levels[0].grid.dims);
             let index = index.unwrap_or(count0 / 2) >> level;

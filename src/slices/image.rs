@@ -3,10 +3,11 @@
 
 use glam::{UVec3, Vec3};
 
+use super::plane::Orientation;
 use super::plane::SliceAxes;
 use super::window_level::WindowLevel;
 use crate::volume::labels::LabelTable;
-use crate::volume::source::VoxelSource;
+use crate::volume::source::{SourceLevel, VoxelSource};
 use crate::volume::{Grid, ValueMap, Volume};
 
 /// One slice of a volume: its voxels' codes as the screen shows them (row by row, top
@@ -22,6 +23,18 @@ pub struct Slice {
     pub index: u32,
     /// The grid the voxels are on (a pyramid level's for a slice of a streamed level).
     pub grid: Grid,
+}
+
+/// The finest level of a pyramid whose `orientation` slices hold at most `max_pixels`
+/// pixels (the coarsest when none does); `None` for a pyramid without levels.
+pub fn finest_level_within(levels: &[SourceLevel], orientation: Orientation, max_pixels: u64) -> Option<usize> {
+    let coarsest = levels.len().checked_sub(1)?;
+    let fits = |k: &usize| {
+        let grid = &levels[*k].grid;
+        let (w, h) = SliceAxes::of(grid.direction, orientation).size(grid.dims);
+        w as u64 * h as u64 <= max_pixels
+    };
+    Some((0..levels.len()).find(fits).unwrap_or(coarsest))
 }
 
 impl Slice {

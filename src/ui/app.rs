@@ -325,7 +325,7 @@ fn automation(
     mut exit: MessageWriter<AppExit>,
     loading: Query<(), With<loading::Loading>>,
     progress: Option<Res<crate::render::RenderProgress>>,
-    stream: Option<Res<crate::streaming::bricked::StreamStatus>>,
+    (stream, slices): (Option<Res<crate::streaming::bricked::StreamStatus>>, Res<super::slice_views::SliceViews>),
     mut streaming_since: Local<Option<std::time::Instant>>,
 ) {
     let Some((after, path)) = state.screenshot_and_exit.clone() else { return };
@@ -333,7 +333,7 @@ fn automation(
     if !loading.is_empty() || !settled {
         return;
     }
-    if state.frames == 0 && !stream.is_none_or(|s| s.converged()) {
+    if state.frames == 0 && (!stream.is_none_or(|s| s.converged()) || slices.reading()) {
         let since = *streaming_since.get_or_insert_with(std::time::Instant::now);
         if since.elapsed() < crate::render::headless::STREAM_WAIT {
             return;

@@ -25,6 +25,7 @@ pub mod rulers;
 pub mod settings;
 pub mod slice_views;
 pub mod state;
+pub mod streamed_slices;
 pub mod streaming_status;
 pub mod tf_editor;
 pub mod viewport;

@@ -75,6 +75,7 @@ type MoreParams<'w, 's> = (
     ResMut<'w, super::movie::MovieRecorder>,
     ResMut<'w, super::settings::Settings>,
     ResMut<'w, super::rulers::RulerTool>,
+    Query<'w, 's, &'static crate::streaming::bricked::BrickedDataset>,
 );
 
 /// Everything the panels read and edit.
@@ -97,7 +98,7 @@ pub fn ui(
     mut lens_params: lenses::LensParams,
     clip_gizmo: Res<super::clip_gizmo::ClipGizmo>,
     mut window_params: super::windows_panel::WindowParams,
-    (explode_specs, mut slice_views, rulers, mut movie, mut settings, mut ruler_tool): MoreParams,
+    (explode_specs, mut slice_views, rulers, mut movie, mut settings, mut ruler_tool, bricked): MoreParams,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(
@@ -299,7 +300,8 @@ pub fn ui(
                     .collect();
             }
         }
-        super::slice_views::panel(&mut root, &mut slice_views, shown, labels, &cuts, (&all_rulers, &mut ruler_tool));
+        let source = shown.and_then(|(e, ..)| bricked.get(e).ok()).map(|b| b.cache.source().clone());
+        super::slice_views::panel(&mut root, &mut slice_views, shown, labels, (&cuts, source.as_ref()), (&all_rulers, &mut ruler_tool));
     }
     // The rest of the window is the 3D viewport.
     let free = root.available_rect_before_wrap();

@@ -12,12 +12,14 @@ use bevy::prelude::*;
 use bevy_egui::egui::{self, Color32, Rect, Stroke, pos2};
 
 use super::rulers::{RULER, RulerTool, draw_ruler};
+use super::streamed_slices::{Native, StreamedSlices, Wanted};
 use crate::dataset::Dataset;
 use crate::region::Ray;
 use crate::slices::lens_outline::{self, LensRays};
 use crate::slices::ruler::{self, Ruler};
 use crate::slices::{CT_PRESETS, Orientation, Slice, SliceAxes, WindowLevel, crosshair, outline, overlay_labels};
 use crate::volume::Volume;
+use crate::volume::source::VoxelSource;
 
 /// The views' colours, as 3D Slicer's: axial red, coronal green, sagittal yellow.
 pub fn colour(o: Orientation) -> Color32 {
@@ -49,9 +51,16 @@ pub struct SliceViews {
     /// The value under the cursor, for the status line.
     pub probe: Option<String>,
     pictures: [Option<Picture>; 3],
+    /// Native slices of a streamed dataset being read.
+    streamed: StreamedSlices,
 }
 
 impl SliceViews {
+    /// Whether a native slice is being read (the screenshot automation waits).
+    pub fn reading(&self) -> bool {
+        self.show && self.streamed.reading()
+    }
+
     /// The views, shown or not (a label dataset laid over them).
     pub fn shown(show: bool) -> SliceViews {
         SliceViews { show, overlay: true, ..Default::default() }
@@ -60,17 +69,28 @@ impl SliceViews {
 
 /// A slice's texture and what it shows.
 struct Picture {
-    key: Key,
+    /// The slice it shows, or stands in for until a streamed one arrives.
+    wanted: SliceKey,
+    /// Whether it shows that slice's own voxels (not the level in memory standing in).
+    native: bool,
+    look: Look,
     texture: egui::TextureHandle,
     slice: Slice,
 }
 
 /// (Volumes by their address: a loaded or replaced volume is a new one.)
-#[derive(Clone, PartialEq)]
-struct Key {
+#[derive(Clone, Copy, PartialEq)]
+struct SliceKey {
     dataset: Entity,
     volume: usize,
+    /// The pyramid level of a streamed dataset (`None`: the volume in memory).
+    level: Option<usize>,
     index: u32,
+}
+
+/// How a slice is painted: its window (grey data) and the label volume laid over it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Look {
     window: Option<(u64, u64)>,
     overlay: Option<usize>,
 }
@@ -94,7 +114,7 @@ pub fn panel(
     views: &mut SliceViews,
     shown: Option<Shown>,
     labels: Option<Shown>,
-    cuts: &Cuts,
+    (cuts, source): (&Cuts, Option<&Arc<dyn VoxelSource>>),
     (rulers, tool): (&[Ruler], &mut RulerTool),
 ) {
     if !views.show {
@@ -174,7 +194,7 @@ pub fn panel(
                         views,
                         k,
                         o,
-                        (entity, dataset),
+                        (entity, dataset, source),
                         point,
                         window,
                         labels.filter(|_| views.overlay),
@@ -199,7 +219,7 @@ fn view(
     views: &mut SliceViews,
     k: usize,
     o: Orientation,
-    (entity, dataset): (Entity, &Dataset),
+    (entity, dataset, source): (Entity, &Dataset, Option<&Arc<dyn VoxelSource>>),
     point: Vec3,
     window: WindowLevel,
     overlay: Option<Shown>,
@@ -207,20 +227,36 @@ fn view(
     (cuts, rulers, tool): (&Cuts, &[Ruler], &mut RulerTool),
 ) {
     let volume = &dataset.volume;
-    let grid = &volume.grid;
-    let axes = SliceAxes::of(grid.direction, o);
-    let index = crosshair::slice_through(&axes, grid, point);
-    let (medical, axis) = o.names();
-    ui.label(egui::RichText::new(format!("{medical} ({axis})  {} / {}", index + 1, axes.count(grid.dims))).color(colour(o)));
-    let key = Key {
+    let memory_axes = SliceAxes::of(volume.grid.direction, o);
+    let memory_index = crosshair::slice_through(&memory_axes, &volume.grid, point);
+    // A streamed dataset's slice comes from the finest level that fits, read in the
+    // background; the level in memory stands in until it arrives.
+    let streamed = source.and_then(|s| Wanted::of(s.as_ref(), entity, o, point).map(|(w, a)| (s, w, a)));
+    let wanted = SliceKey {
         dataset: entity,
         volume: Arc::as_ptr(volume) as usize,
-        index,
+        level: streamed.map(|(_, w, _)| w.level),
+        index: streamed.map_or(memory_index, |(_, w, _)| w.index),
+    };
+    let native = match streamed {
+        Some((s, w, a)) => views.streamed.poll(k, w, a, s),
+        None => Native::Taken,
+    };
+    let look = Look {
         window: dataset.labels.is_none().then(|| (window.width.to_bits(), window.level.to_bits())),
         overlay: overlay.map(|(_, d, _)| Arc::as_ptr(&d.volume) as usize),
     };
-    if views.pictures[k].as_ref().is_none_or(|p| p.key != key) {
-        let slice = Slice::of_volume(volume, axes, index);
+    let (medical, axis) = o.names();
+    let reading = matches!(native, Native::Reading);
+    let failed = if let Native::Failed(e) = &native { Some(e.clone()) } else { None };
+    let fresh = match native {
+        Native::Ready(slice) => Some((slice, true)),
+        _ if views.pictures[k].as_ref().is_none_or(|p| p.wanted != wanted) => {
+            Some((Slice::of_volume(volume, memory_axes, memory_index), streamed.is_none()))
+        }
+        _ => None,
+    };
+    let paint = |slice: &Slice| {
         let mut pixels = match &dataset.labels {
             Some(table) => slice.labels(table),
             None => slice.grey(&window),
@@ -228,10 +264,13 @@ fn view(
         if let Some((_, labels, transform)) = overlay
             && let Some(table) = &labels.labels
         {
-            overlay_labels(&mut pixels, &slice, &labels.volume, transform.compute_affine(), table, OVERLAY_OPACITY);
+            overlay_labels(&mut pixels, slice, &labels.volume, transform.compute_affine(), table, OVERLAY_OPACITY);
         }
         let rgba: Vec<u8> = pixels.iter().flatten().copied().collect();
-        let image = egui::ColorImage::from_rgba_unmultiplied([slice.width as usize, slice.height as usize], &rgba);
+        egui::ColorImage::from_rgba_unmultiplied([slice.width as usize, slice.height as usize], &rgba)
+    };
+    if let Some((slice, is_native)) = fresh {
+        let image = paint(&slice);
         let texture = match views.pictures[k].take() {
             Some(mut p) => {
                 p.texture.set(image, egui::TextureOptions::NEAREST);
@@ -239,9 +278,25 @@ fn view(
             }
             None => ui.ctx().load_texture(format!("slice_{medical}"), image, egui::TextureOptions::NEAREST),
         };
-        views.pictures[k] = Some(Picture { key, texture, slice });
+        views.pictures[k] = Some(Picture { wanted, native: is_native, look, texture, slice });
+    } else if let Some(p) = views.pictures[k].as_mut()
+        && p.look != look
+    {
+        p.texture.set(paint(&p.slice), egui::TextureOptions::NEAREST);
+        p.look = look;
     }
     let Some(picture) = &views.pictures[k] else { return };
+    // Geometry from the slice shown (a pyramid level's grid for a native streamed one).
+    let (grid, axes, index) = (&picture.slice.grid, picture.slice.axes, picture.slice.index);
+    let mut header = format!("{medical} ({axis})  {} / {}", index + 1, axes.count(grid.dims));
+    let level = streamed.map(|(_, w, _)| w.level);
+    match (level, failed) {
+        (Some(l), Some(e)) => header += &format!("  · level {l} unreadable: {e}"),
+        (Some(l), None) if reading && !picture.native => header += &format!("  · reading level {l}…"),
+        (Some(l), None) if picture.native && l > 0 => header += &format!("  · level {l}"),
+        _ => {}
+    }
+    ui.label(egui::RichText::new(header).color(colour(o)));
     let size = crosshair::fit((picture.slice.width, picture.slice.height), axes.pixel_mm(grid.spacing), glam::Vec2::new(cell.x, cell.y));
     let (rect, response) = ui.allocate_exact_size(egui::vec2(size.x, size.y), egui::Sense::click_and_drag());
     let painter = ui.painter_at(rect);
@@ -330,7 +385,7 @@ fn view(
             let moved = grid.index_to_world().transform_point3(q);
             views.crosshair = Some(moved);
         }
-        views.probe = probe(&picture.slice, dataset, to_pixel(p));
+        views.probe = probe(&picture.slice, dataset, to_pixel(p), level.filter(|_| picture.native));
     }
     if let Some(point) = ruler_end {
         tool.end(entity, point);
@@ -338,7 +393,8 @@ fn view(
 }
 
 /// The value (and label) of the voxel under continuous pixel `px`.
-fn probe(slice: &Slice, dataset: &Dataset, px: glam::Vec2) -> Option<String> {
+/// (`level`: the pyramid level the slice's voxels are of, when not the volume's own.)
+fn probe(slice: &Slice, dataset: &Dataset, px: glam::Vec2, level: Option<usize>) -> Option<String> {
     let (x, y) = (px.x.round(), px.y.round());
     if x < 0.0 || y < 0.0 || x >= slice.width as f32 || y >= slice.height as f32 {
         return None;
@@ -347,9 +403,10 @@ fn probe(slice: &Slice, dataset: &Dataset, px: glam::Vec2) -> Option<String> {
     let code = slice.codes[(y as u32 * slice.width + x as u32) as usize];
     let value = slice.values.to_real(code as f64);
     let units = slice.values.units.as_deref().map(|u| format!(" {u}")).unwrap_or_default();
+    let of_level = level.filter(|l| *l > 0).map(|l| format!(" of level {l}")).unwrap_or_default();
     Some(match &dataset.labels {
-        Some(table) => format!("voxel ({}, {}, {}): label {} {}", v.x, v.y, v.z, value, table.name(value as u32)),
-        None => format!("voxel ({}, {}, {}): {value}{units}", v.x, v.y, v.z),
+        Some(table) => format!("voxel ({}, {}, {}){of_level}: label {} {}", v.x, v.y, v.z, value, table.name(value as u32)),
+        None => format!("voxel ({}, {}, {}){of_level}: {value}{units}", v.x, v.y, v.z),
     })
 }
 
