@@ -44,7 +44,7 @@ impl Plugin for FocalAppPlugin {
             .init_resource::<window_tools::WindowTools>()
             .init_resource::<explode_tools::ExplodeUi>()
             .init_resource::<explode_overlay::CutPreview>()
-            .init_resource::<super::streaming_status::LevelUnderCursor>()
+            .init_resource::<super::under_cursor::UnderCursor>()
             .insert_resource(super::slice_views::SliceViews::shown(self.slices))
             .init_resource::<super::movie::MovieRecorder>()
             .init_resource::<super::rulers::RulerTool>()
@@ -86,7 +86,7 @@ impl Plugin for FocalAppPlugin {
                 (
                     crate::explode::systems::run_steps,
                     open_explode_panel,
-                    super::streaming_status::level_under_cursor,
+                    super::under_cursor::pick_under_cursor,
                     super::slice_views::slice_keys,
                     super::rulers::apply_rulers,
                     (super::settings::remember_opened, super::settings::save_settings).chain(),
@@ -95,7 +95,13 @@ impl Plugin for FocalAppPlugin {
             )
             .add_systems(
                 EguiPrimaryContextPass,
-                (panels::ui, explode_panel::explode_panel, explode_overlay::explode_overlay, super::streaming_status::streaming_status)
+                (
+                    panels::ui,
+                    explode_panel::explode_panel,
+                    explode_overlay::explode_overlay,
+                    super::streaming_status::streaming_status,
+                    super::under_cursor::probe_text,
+                )
                     .chain(),
             );
     }

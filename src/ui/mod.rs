@@ -28,6 +28,7 @@ pub mod state;
 pub mod streamed_slices;
 pub mod streaming_status;
 pub mod tf_editor;
+pub mod under_cursor;
 pub mod viewport;
 pub mod window_tools;
 pub mod windows_panel;
