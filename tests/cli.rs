@@ -263,3 +263,36 @@ fn the_apps_movie_job_records_a_scene_turntable_and_an_animation() {
         other => panic!("{other:?}"),
     }
 }
+
+#[test]
+#[cfg(unix)]
+fn a_turntable_becomes_an_mp4_through_ffmpeg_where_it_is_installed() {
+    use std::os::unix::fs::PermissionsExt;
+    // A stand-in ffmpeg on the PATH that records how it was called and writes its output
+    // file: the MP4 step's arguments (frame rate, the PNG pattern, H.264 in yuv420p).
+    let dir = scratch("cli-mp4");
+    let bin = dir.join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    let ffmpeg = bin.join("ffmpeg");
+    let log = dir.join("ffmpeg-args.txt");
+    std::fs::write(
+        &ffmpeg,
+        format!("#!/bin/sh\necho \"$@\" >> '{}'\nfor last; do :; done\n[ \"$1\" = -version ] || : > \"$last\"\n", log.display()),
+    )
+    .unwrap();
+    std::fs::set_permissions(&ffmpeg, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    let out = focal()
+        .args(["render", "phantom:sphere", "--cpu", "--resolution", "16", "--size", "24x16", "--turntable", "2", "--out"])
+        .arg(dir.join("orbit"))
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(dir.join("orbit/turntable.mp4").exists());
+    let args = std::fs::read_to_string(&log).unwrap();
+    let call = args.lines().find(|l| l.contains(".mp4")).unwrap_or_else(|| panic!("no encoding call: {args}"));
+    for expected in ["-framerate 25", "turntable-%04d.png", "libx264", "yuv420p"] {
+        assert!(call.contains(expected), "{expected} missing from: {call}");
+    }
+}
