@@ -292,7 +292,7 @@ fn a_turntable_becomes_an_mp4_through_ffmpeg_where_it_is_installed() {
     assert!(dir.join("orbit/turntable.mp4").exists());
     let args = std::fs::read_to_string(&log).unwrap();
     let call = args.lines().find(|l| l.contains(".mp4")).unwrap_or_else(|| panic!("no encoding call: {args}"));
-    for expected in ["-framerate 25", "turntable-%04d.png", "libx264", "yuv420p"] {
+    for expected in ["-framerate 25", "turntable-%04d.png", "-frames:v 2", "libx264", "yuv420p"] {
         assert!(call.contains(expected), "{expected} missing from: {call}");
     }
 }

@@ -189,9 +189,12 @@ fn render(args: &RenderArgs) -> Result<(), String> {
 fn turntable(scene: SceneFile, n: u32, base: &Path, args: &RenderArgs, options: RunOptions) -> Result<(), String> {
     use focal::scene::movie;
     let scene = movie::turntable(scene, n, args.azimuth.unwrap_or(0.0), args.elevation.unwrap_or(20.0), args.ortho, args.zoom);
-    let frames = render_frames(scene, base, &RunOptions { progress: true, ..options })?;
     let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("out/turntable"));
-    for p in movie::write(&frames, &dir, "turntable", movie::FPS)? {
+    let mut writer = movie::MovieWriter::new(&dir, "turntable", movie::FPS)?;
+    focal::scene::run::render_frames_into(scene, base, &RunOptions { progress: true, ..options }, &mut |name, image| {
+        writer.add(&name, &image)
+    })?;
+    for p in writer.finish()? {
         println!("{}", p.display());
     }
     Ok(())

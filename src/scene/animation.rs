@@ -280,6 +280,22 @@ impl Track {
         }
     }
 
+    /// Checks the track's value at time `t` (its keys checked already).
+    fn check_value_at(&self, t: f32) -> Result<(), String> {
+        let at_least_zero = |v: f32, what: &str| if v >= 0.0 { Ok(()) } else { Err(format!("{what} {v} is negative")) };
+        match self {
+            Track::Camera { keys, ease } => match value_at(keys, *ease, t) {
+                CameraSpec::View { zoom, .. } | CameraSpec::Orbit { zoom, .. } if zoom <= 0.0 => {
+                    Err(format!("zoom {zoom} is not positive"))
+                }
+                _ => Ok(()),
+            },
+            Track::Lens { keys, ease, .. } => value_at(keys, *ease, t).validate(),
+            Track::KappaT { keys, ease, .. } => at_least_zero(value_at(keys, *ease, t), "κt"),
+            Track::Explosion { keys, ease, .. } => at_least_zero(value_at(keys, *ease, t), "the degree of explosion"),
+        }
+    }
+
     fn check(&self, scene: &Refers, duration: f32) -> Result<(), String> {
         let n = scene.exploded.len();
         let dataset = |d: usize| if d < n { Ok(()) } else { Err(format!("dataset {d}: the scene has {n}")) };
@@ -300,8 +316,7 @@ impl Track {
                     return Err(format!("lens {lens}: the scene has {} (an animated lens must be in `lenses`)", scene.lenses));
                 }
                 check_keys(keys, duration)?;
-                let values: Vec<Lens> = keys.iter().map(|k| k.value.clone()).collect();
-                crate::lens::stack::validate_lenses(&values)
+                keys.iter().enumerate().try_for_each(|(i, k)| k.value.validate().map_err(|e| format!("key {i}: {e}")))
             }
             Track::KappaT { dataset: d, keys, .. } => {
                 dataset(*d)?;
@@ -347,6 +362,19 @@ impl Animation {
         }
         for (i, track) in self.tracks.iter().enumerate() {
             track.check(scene, self.duration_s).map_err(|e| fail(format!("track {i} ({}): {e}", track.name())))?;
+        }
+        // Every frame's values: a spline may overshoot its keys (a negative κt, a
+        // magnification below 1).
+        for k in 0..self.frame_count() {
+            let t = self.time_of(k);
+            for (i, track) in self.tracks.iter().enumerate() {
+                track.check_value_at(t).map_err(|e| {
+                    fail(format!(
+                        "track {i} ({}) at t = {t:.3} s, between keys: {e} (the spline overshoots: ease smooth, or add keys)",
+                        track.name()
+                    ))
+                })?;
+            }
         }
         Ok(())
     }
@@ -499,6 +527,15 @@ mod tests {
         assert!(err("Explosion(dataset: 0, keys: [(t: 0, value: 1)])").contains("not exploded"));
         let mixed = "Camera(keys: [(t: 0, value: Orbit(azimuth_deg: 0, elevation_deg: 0)), (t: 1, value: View(view: left))])";
         assert!(err(mixed).contains("different kinds"));
+        // Five lens keys are one lens's path, not five lenses.
+        let key = |t: f32| format!("(t: {t}, value: (kind: magnifier(magnification: 2.0)))");
+        let five = format!("Lens(lens: 0, keys: [{}])", (0..5).map(|k| key(k as f32 * 0.5)).collect::<Vec<_>>().join(", "));
+        animation(&ORBIT.replace(ORBIT_TRACKS, &five)).validate(&refers()).unwrap();
+        // A spline through 0, 0, 6 dips below 0 between the first two keys (−0.375 at
+        // 0.5 s: m₁ = 3, h₁₁(½)·Δ·m₁ = −⅛·1·3).
+        assert!((value_at(&keys(&[(0.0, 0.0), (1.0, 0.0), (2.0, 6.0)]), Ease::Spline, 0.5) + 0.375).abs() < 1e-6);
+        let dip = err("KappaT(dataset: 0, keys: [(t: 0, value: 0), (t: 1, value: 0), (t: 2, value: 6)], ease: spline),");
+        assert!(dip.contains("track 2 (KappaT) at t = 0.250 s, between keys: κt") && dip.contains("overshoots"), "{dip}");
         let long = animation(&ORBIT.replace("duration_s: 2.0, fps: 4", "duration_s: 100.0, fps: 60"));
         assert!(long.validate(&refers()).unwrap_err().contains("more than 3600 frames"));
     }

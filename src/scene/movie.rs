@@ -52,43 +52,58 @@ pub fn animation_frames(animation: &Animation, scene: &SceneFile, prefix: &str) 
         .collect()
 }
 
-/// Writes the frames (named `{name}-0000` …) into `dir` at `fps` frames a second: the
-/// PNG sequence, `{name}.gif`, `{name}.mp4` where ffmpeg is; returns what it wrote.
-pub fn write(frames: &[(String, image::RgbaImage)], dir: &Path, name: &str, fps: u32) -> Result<Vec<PathBuf>, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let mut written = Vec::new();
-    for (frame, image) in frames {
-        let path = dir.join(format!("{frame}.png"));
-        image.save(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-        written.push(path);
-    }
-    let gif = dir.join(format!("{name}.gif"));
-    write_gif(frames, &gif, fps).map_err(|e| format!("{}: {e}", gif.display()))?;
-    written.push(gif);
-    match write_mp4(dir, name, fps) {
-        Ok(Some(mp4)) => written.push(mp4),
-        Ok(None) => eprintln!("no ffmpeg on the PATH: no MP4 (the PNG sequence and the GIF are written)"),
-        Err(e) => eprintln!("warning: the MP4 was not written: {e}"),
-    }
-    Ok(written)
+/// A movie being written into `dir` at `fps` frames a second, a frame at a time as it is
+/// drawn: each frame's PNG (named as the frame), `{name}.gif` growing, and at the end
+/// `{name}.mp4` where ffmpeg is.
+pub struct MovieWriter {
+    dir: PathBuf,
+    name: String,
+    fps: u32,
+    gif: image::codecs::gif::GifEncoder<std::io::BufWriter<std::fs::File>>,
+    written: Vec<PathBuf>,
 }
 
-fn write_gif(frames: &[(String, image::RgbaImage)], path: &Path, fps: u32) -> Result<(), String> {
-    use image::codecs::gif::{GifEncoder, Repeat};
-    let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
-    let mut encoder = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
-    encoder.set_repeat(Repeat::Infinite).map_err(|e| e.to_string())?;
-    let delay = image::Delay::from_numer_denom_ms(1000, fps);
-    for (k, (_, image)) in frames.iter().enumerate() {
-        eprint!("\rGIF frame {}/{}", k + 1, frames.len());
-        encoder.encode_frame(image::Frame::from_parts(image.clone(), 0, 0, delay)).map_err(|e| e.to_string())?;
+impl MovieWriter {
+    pub fn new(dir: &Path, name: &str, fps: u32) -> Result<MovieWriter, String> {
+        use image::codecs::gif::{GifEncoder, Repeat};
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let path = dir.join(format!("{name}.gif"));
+        let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+        let file = std::fs::File::create(&path).map_err(|e| fail(&e))?;
+        let mut gif = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
+        gif.set_repeat(Repeat::Infinite).map_err(|e| fail(&e))?;
+        Ok(MovieWriter { dir: dir.to_path_buf(), name: name.to_string(), fps, gif, written: Vec::new() })
     }
-    eprintln!();
-    Ok(())
+
+    /// Adds frame `frame` (its PNG's name).
+    pub fn add(&mut self, frame: &str, image: &image::RgbaImage) -> Result<(), String> {
+        let path = self.dir.join(format!("{frame}.png"));
+        image.save(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        self.written.push(path);
+        let delay = image::Delay::from_numer_denom_ms(1000, self.fps);
+        self.gif
+            .encode_frame(image::Frame::from_parts(image.clone(), 0, 0, delay))
+            .map_err(|e| format!("{}: {e}", self.dir.join(format!("{}.gif", self.name)).display()))
+    }
+
+    /// Closes the GIF and makes the MP4; returns what was written.
+    pub fn finish(self) -> Result<Vec<PathBuf>, String> {
+        let MovieWriter { dir, name, fps, gif, mut written } = self;
+        let count = written.len();
+        drop(gif);
+        written.push(dir.join(format!("{name}.gif")));
+        match write_mp4(&dir, &name, fps, count) {
+            Ok(Some(mp4)) => written.push(mp4),
+            Ok(None) => eprintln!("no ffmpeg on the PATH: no MP4 (the PNG sequence and the GIF are written)"),
+            Err(e) => eprintln!("warning: the MP4 was not written: {e}"),
+        }
+        Ok(written)
+    }
 }
 
 /// `{name}.mp4` from the PNG sequence with ffmpeg; `None` where there is none.
-fn write_mp4(dir: &Path, name: &str, fps: u32) -> Result<Option<PathBuf>, String> {
+/// (Only the first `count` frames: older, longer sequences may lie in the folder.)
+fn write_mp4(dir: &Path, name: &str, fps: u32, count: usize) -> Result<Option<PathBuf>, String> {
     if std::process::Command::new("ffmpeg").arg("-version").output().is_err() {
         return Ok(None);
     }
@@ -97,6 +112,7 @@ fn write_mp4(dir: &Path, name: &str, fps: u32) -> Result<Option<PathBuf>, String
         .args(["-y", "-loglevel", "error", "-framerate", &fps.to_string(), "-i"])
         .arg(dir.join(format!("{name}-%04d.png")))
         // (Even dimensions for yuv420p.)
+        .args(["-frames:v", &count.to_string()])
         .args(["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p"])
         .arg(&mp4)
         .output()

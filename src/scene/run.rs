@@ -37,7 +37,7 @@ fn frames(scene: &SceneFile) -> Vec<FrameSpec> {
 }
 
 /// A file-name-safe version of a frame name.
-fn slug(name: &str) -> String {
+pub fn slug(name: &str) -> String {
     name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
 }
 
@@ -52,8 +52,10 @@ pub fn render_scene_file(path: &Path, options: &RunOptions) -> Result<Vec<PathBu
     let mut written = Vec::new();
     if let Some(animation) = &scene.animation {
         let movie = SceneFile { frames: super::movie::animation_frames(animation, &scene, &stem), animation: None, ..scene.clone() };
-        let images = render_frames(movie, &base, &RunOptions { progress: true, ..options.clone() }).map_err(in_file)?;
-        written.extend(super::movie::write(&images, &options.out_dir.join(&stem), &stem, animation.fps)?);
+        let mut writer = super::movie::MovieWriter::new(&options.out_dir.join(&stem), &stem, animation.fps)?;
+        render_frames_into(movie, &base, &RunOptions { progress: true, ..options.clone() }, &mut |name, image| writer.add(&name, &image))
+            .map_err(in_file)?;
+        written.extend(writer.finish()?);
         if scene.frames.is_empty() {
             return Ok(written);
         }
@@ -69,7 +71,23 @@ pub fn render_scene_file(path: &Path, options: &RunOptions) -> Result<Vec<PathBu
 }
 
 /// Renders every frame of `scene` (relative paths start at `base`): (frame name, image).
-pub fn render_frames(mut scene: SceneFile, base: &Path, options: &RunOptions) -> Result<Vec<(String, image::RgbaImage)>, String> {
+pub fn render_frames(scene: SceneFile, base: &Path, options: &RunOptions) -> Result<Vec<(String, image::RgbaImage)>, String> {
+    let mut images = Vec::new();
+    render_frames_into(scene, base, options, &mut |name, image| {
+        images.push((name, image));
+        Ok(())
+    })?;
+    Ok(images)
+}
+
+/// Renders every frame of `scene`, handing each to `sink` as soon as it is drawn (so a
+/// movie never holds all its frames).
+pub fn render_frames_into(
+    mut scene: SceneFile,
+    base: &Path,
+    options: &RunOptions,
+    sink: &mut dyn FnMut(String, image::RgbaImage) -> Result<(), String>,
+) -> Result<(), String> {
     let mut datasets = load_datasets(&scene, base)?;
     let (w, h) = options.size.unwrap_or(scene.size);
     // Frame on what the first frame shows; a frame that sets a camera frames anew what it
@@ -77,7 +95,6 @@ pub fn render_frames(mut scene: SceneFile, base: &Path, options: &RunOptions) ->
     let mut bounds = visible_bounds(&datasets);
     let mut camera_spec = scene.camera.clone();
     let mut gpu = if options.cpu { None } else { Some(GpuRun::new(w, h, &datasets)?) };
-    let mut images = Vec::new();
     let all = frames(&scene);
     for (k, frame) in all.iter().enumerate() {
         if options.progress && all.len() > 1 {
@@ -98,12 +115,12 @@ pub fn render_frames(mut scene: SceneFile, base: &Path, options: &RunOptions) ->
             None if exploded => return Err("exploded views are simulated in the app: render this scene without --cpu".into()),
             None => render_lensed(&render_scene_with_windows(&datasets, &scene, &cam, base)?, &cam, &scene.lenses, w, h)?.to_image()?,
         };
-        images.push((frame.name.clone(), image));
+        sink(frame.name.clone(), image)?;
     }
     if options.progress && all.len() > 1 {
         eprintln!();
     }
-    Ok(images)
+    Ok(())
 }
 
 /// The offscreen app showing a scene's datasets.

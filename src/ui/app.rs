@@ -95,13 +95,7 @@ impl Plugin for FocalAppPlugin {
             )
             .add_systems(
                 EguiPrimaryContextPass,
-                (
-                    panels::ui,
-                    explode_panel::explode_panel,
-                    explode_overlay::explode_overlay,
-                    super::streaming_status::streaming_status,
-                    super::under_cursor::probe_text,
-                )
+                (panels::ui, explode_panel::explode_panel, explode_overlay::explode_overlay, super::streaming_status::streaming_status)
                     .chain(),
             );
     }

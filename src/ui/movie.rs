@@ -76,7 +76,8 @@ impl MovieJob {
     pub fn start(exe: &Path, scene: &Path, kind: MovieKind, dir: &Path, extra: &[String]) -> Result<MovieJob, String> {
         let mut command = Command::new(exe);
         command.arg("render").arg(scene).args(extra);
-        let stem = scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        // (Named as `focal render` names it.)
+        let stem = crate::scene::run::slug(&scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into()));
         let gif = match kind {
             MovieKind::Turntable { frames, elevation_deg } => {
                 command.args(["--turntable", &frames.to_string(), "--elevation", &elevation_deg.to_string(), "--out"]).arg(dir);
@@ -87,6 +88,9 @@ impl MovieJob {
                 dir.join(&stem).join(format!("{stem}.gif"))
             }
         };
+        // Its own process group, so a cancel reaches its ffmpeg too.
+        #[cfg(unix)]
+        std::os::unix::process::CommandExt::process_group(&mut command, 0);
         let mut child =
             command.stdout(Stdio::null()).stderr(Stdio::piped()).spawn().map_err(|e| format!("could not start {}: {e}", exe.display()))?;
         let progress = Arc::new(Mutex::new(Progress::default()));
@@ -134,8 +138,10 @@ impl MovieJob {
         }
     }
 
-    /// Stops the child.
+    /// Stops the child (and, on Unix, what it started: its process group).
     pub fn cancel(&mut self) {
+        #[cfg(unix)]
+        let _ = Command::new("kill").args(["-KILL", &format!("-{}", self.child.id())]).status();
         let _ = self.child.kill();
         let _ = self.child.wait();
     }

@@ -76,6 +76,7 @@ type MoreParams<'w, 's> = (
     ResMut<'w, super::settings::Settings>,
     ResMut<'w, super::rulers::RulerTool>,
     Query<'w, 's, &'static crate::streaming::bricked::BrickedDataset>,
+    Res<'w, super::under_cursor::UnderCursor>,
 );
 
 /// Everything the panels read and edit.
@@ -98,7 +99,7 @@ pub fn ui(
     mut lens_params: lenses::LensParams,
     clip_gizmo: Res<super::clip_gizmo::ClipGizmo>,
     mut window_params: super::windows_panel::WindowParams,
-    (explode_specs, mut slice_views, rulers, mut movie, mut settings, mut ruler_tool, bricked): MoreParams,
+    (explode_specs, mut slice_views, rulers, mut movie, mut settings, mut ruler_tool, bricked, under_cursor): MoreParams,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(
@@ -320,6 +321,8 @@ pub fn ui(
         super::clip_gizmo::overlay(&ctx, free, &clip_gizmo, chosen, camera);
         let base = rows.iter().copied().find(|(e, ..)| Some(*e) == slice_base);
         super::slice_views::planes_overlay(&ctx, free, &slice_views, base, camera);
+        let slice_probe = slice_views.probe.as_deref().filter(|_| slice_views.show);
+        super::under_cursor::probe_overlay(&ctx, free, slice_probe.or(under_cursor.probe.as_deref()));
         let placed: Vec<_> = all_rulers
             .iter()
             .filter_map(|r| rows.iter().find(|(e, ..)| *e == r.dataset).map(|(_, _, t)| (*r, t.compute_affine())))

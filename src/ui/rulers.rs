@@ -1,6 +1,6 @@
 //! Distance rulers in the app: Shift+click two points, in a slice view or on the surface
-//! the 3D view shows (picked with the CPU reference renderer under the view's transfer
-//! functions, as a double-click picks its centre); the rulers are drawn in the 3D view
+//! the 3D view shows (the point under the cursor, picked with the CPU reference renderer
+//! through the lenses under the view's transfer functions); the rulers are drawn in the 3D view
 //! and in the slices they pass through, with their length in millimetres
 //! ([`crate::slices::ruler`]).
 
@@ -9,10 +9,8 @@ use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use bevy_egui::egui::{self, Color32, Rect, Stroke, pos2};
 
-use super::orbit::{OrbitCamera, PointerInViewport};
-use super::state::MainCamera;
-use super::viewport::viewport_logical;
-use crate::dataset::SceneRegions;
+use super::orbit::PointerInViewport;
+use super::under_cursor::UnderCursor;
 use crate::slices::ruler::Ruler;
 
 /// The rulers' colour.
@@ -94,20 +92,18 @@ pub fn overlay(ctx: &egui::Context, free: Rect, camera: Option<crate::region::Ca
     }
 }
 
-/// Shift+click in the 3D view: a ruler's end on the first visible point under the cursor.
-// A Bevy system: its parameters are the resources and queries it uses.
-#[allow(clippy::too_many_arguments)]
+/// Shift+click in the 3D view: a ruler's end on the first visible point under the cursor
+/// (picked through the lenses, [`super::under_cursor`]).
 pub fn ruler_on_surface(
     buttons: Res<ButtonInput<MouseButton>>,
     keys: Res<ButtonInput<KeyCode>>,
     windows: Query<&Window, With<PrimaryWindow>>,
     pointer: Res<PointerInViewport>,
-    regions: Res<SceneRegions>,
-    cams: Query<(&OrbitCamera, &Camera), With<MainCamera>>,
+    under: Res<UnderCursor>,
     mut tool: ResMut<RulerTool>,
     mut pressed_at: Local<Option<Vec2>>,
 ) {
-    let (Ok(window), Ok((orbit, camera))) = (windows.single(), cams.single()) else { return };
+    let Ok(window) = windows.single() else { return };
     let shift = keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]);
     let cursor = window.cursor_position();
     if buttons.just_pressed(MouseButton::Left) {
@@ -117,55 +113,10 @@ pub fn ruler_on_surface(
         return;
     }
     let (Some(start), Some(cursor)) = (pressed_at.take(), cursor) else { return };
-    if !shift || start.distance(cursor) > CLICK_SLOP {
-        return;
-    }
-    let (origin, size) = viewport_logical(camera, window);
-    let p = cursor - origin;
-    let ray = orbit.camera().ray(p.x, p.y, size.x.max(1.0) as u32, size.y.max(1.0) as u32);
-    if let Some((dataset, point)) = surface_point(&regions, ray) {
+    if shift
+        && start.distance(cursor) <= CLICK_SLOP
+        && let Some((dataset, point)) = under.point
+    {
         tool.end(dataset, point);
-    }
-}
-
-/// The dataset and the point (in the dataset's own frame, where its rulers live) of the
-/// first visible point along `ray`. Through the region's own map, so a point on a
-/// moved part or in a window is where the data is.
-pub fn surface_point(regions: &SceneRegions, ray: crate::region::Ray) -> Option<(Entity, Vec3)> {
-    let hit = crate::reference::pick(&regions.scene, ray).ok().flatten()?;
-    let region = regions.scene.regions.get(hit.region)?;
-    let volume = regions.scene.volumes.get(region.volume)?;
-    let dataset = *regions.datasets.get(region.volume)?;
-    let q = region.world_to_voxel.transform_point3(hit.position);
-    Some((dataset, volume.grid.index_to_world().transform_point3(q)))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::scene::SceneFile;
-    use crate::scene::load::{load_datasets, render_scene};
-
-    #[test]
-    fn a_surface_point_is_on_the_sphere_in_the_datasets_own_frame() {
-        // The sphere phantom (radius 0.35·n voxels), moved 500 mm along x: a ray along −x
-        // through its centre meets the surface one radius before the centre, and the point
-        // comes back in the dataset's frame, not the world's.
-        let scene =
-            SceneFile::parse("(datasets: [(source: Phantom(kind: sphere, resolution: 40), translation: (500, 0, 0))])", "t").unwrap();
-        let datasets = load_datasets(&scene, std::path::Path::new(".")).unwrap();
-        let grid = &datasets[0].volume.grid;
-        let centre = grid.index_to_world().transform_point3((grid.dims.as_vec3() - 1.0) * 0.5);
-        let radius = 0.35 * 40.0 * grid.spacing.x;
-        let regions = SceneRegions { scene: render_scene(&datasets, &scene), datasets: vec![Entity::from_raw_u32(7).unwrap()] };
-        let world_centre = centre + Vec3::new(500.0, 0.0, 0.0);
-        let ray = crate::region::Ray { origin: world_centre + Vec3::new(1000.0, 0.0, 0.0), dir: Vec3::NEG_X };
-        let (dataset, point) = surface_point(&regions, ray).expect("the ray meets the sphere");
-        assert_eq!(dataset, regions.datasets[0]);
-        assert!((point.distance(centre) - radius).abs() < 2.0 * grid.spacing.x, "{point} from {centre}: {radius}");
-        assert!(point.x > centre.x, "on the side facing the eye");
-        // A ray that misses: nothing.
-        let miss = crate::region::Ray { origin: world_centre + Vec3::new(1000.0, 0.0, 3.0 * radius), dir: Vec3::NEG_X };
-        assert!(surface_point(&regions, miss).is_none());
     }
 }

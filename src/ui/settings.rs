@@ -40,7 +40,15 @@ impl Settings {
             Err(e) => (Settings::default(), Some(format!("{}: {e}", path.display()))),
             Ok(text) => match ron::from_str::<Settings>(&text) {
                 Ok(s) => (s, None),
-                Err(e) => (Settings::default(), Some(format!("{}: {e} (starting with default settings)", path.display()))),
+                Err(e) => {
+                    // Kept for the user (hand-edited, perhaps), out of the way of the next write.
+                    let aside = path.with_extension("ron.bad");
+                    let kept = match std::fs::rename(path, &aside) {
+                        Ok(()) => format!("set aside as {}", aside.display()),
+                        Err(r) => format!("not set aside: {r}"),
+                    };
+                    (Settings::default(), Some(format!("{}: {e} (starting with default settings; the file is {kept})", path.display())))
+                }
             },
         }
     }
@@ -142,6 +150,8 @@ mod tests {
         std::fs::write(&path, "(recent: [42").unwrap();
         let (read, warning) = Settings::read(&path);
         assert_eq!(read, Settings::default());
-        assert!(warning.is_some_and(|w| w.contains("settings.ron")));
+        assert!(warning.is_some_and(|w| w.contains("settings.ron") && w.contains("set aside")));
+        assert_eq!(std::fs::read_to_string(path.with_extension("ron.bad")).unwrap(), "(recent: [42", "the bad file is kept");
+        assert!(!path.exists());
     }
 }

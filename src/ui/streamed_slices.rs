@@ -2,8 +2,8 @@
 //! coarse level in memory; each view asks for its slice through the crosshair at the
 //! finest level whose slice fits [`MAX_APP_SLICE_PIXELS`], read on the compute pool
 //! ([`Slice::of_source`]: one voxel-thick box). Until it arrives the view shows the level
-//! in memory and says which level is on its way; a read the crosshair has left behind
-//! is dropped (and with it its task).
+//! in memory and says which level is on its way. A view has one read at a time: while
+//! the crosshair is dragged, the read under way finishes before the next one starts.
 
 use std::sync::Arc;
 
@@ -66,6 +66,16 @@ impl StreamedSlices {
     /// Where view `k`'s slice `wanted` stands, starting its read when it is new.
     pub fn poll(&mut self, k: usize, wanted: Wanted, axes: SliceAxes, source: &Arc<dyn VoxelSource>) -> Native {
         let entry = &mut self.reads[k];
+        // One read at a time per view (a read cannot be stopped once it runs): a read the
+        // crosshair has left finishes first, unused, then the one wanted now starts.
+        if let Some((w, Read::Running(task))) = entry
+            && *w != wanted
+        {
+            if check_ready(task).is_none() {
+                return Native::Reading;
+            }
+            *entry = None;
+        }
         if entry.as_ref().is_none_or(|(w, _)| *w != wanted) {
             let source = source.clone();
             let task =

@@ -1,41 +1,46 @@
 //! What lies under the cursor in the 3D view: the first visible point along the
 //! cursor's ray (through the lenses), picked on the CPU with the reference renderer again
-//! only when the cursor, the lenses or the scene change. The value probe shows the
+//! only when the cursor, the camera, the lenses or the scene change. The value probe shows the
 //! dataset, the voxel and its value (and label) there at the top left of the 3D view;
 //! the streaming status line looks the level drawn there up in the frame's bricks.
 //! (On a streamed dataset the pick sees the level in memory.)
 
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
-use bevy_egui::{EguiContexts, egui};
+use bevy_egui::egui;
 
 use super::orbit::PointerInViewport;
-use super::slice_views::SliceViews;
 use super::state::MainCamera;
 use super::viewport::viewport_logical;
-use crate::dataset::SceneRegions;
+use crate::dataset::{Dataset, SceneRegions};
 use crate::lens::ViewLenses;
 use crate::lens::stack::lens_ray;
 use crate::reference::Hit;
 
+/// What a pick was made for: the ray's pixel (viewport pixels), the view's camera and
+/// screen, and its lenses.
+type PickedFor = (Vec2, Option<crate::region::Camera>, Option<crate::lens::Screen>, Vec<crate::lens::stack::ResolvedLens>);
+
 /// The first visible point under the cursor.
 #[derive(Resource, Default)]
 pub struct UnderCursor {
-    /// The ray's pixel (viewport pixels) and the lenses the hit was picked under.
-    picked_for: Option<(Vec2, Vec<crate::lens::stack::ResolvedLens>)>,
+    picked_for: Option<PickedFor>,
     /// The scene volume and its voxel index (continuous) there.
     pub hit: Option<(usize, Vec3)>,
+    /// The dataset and the point in its own frame (where its rulers live).
+    pub point: Option<(Entity, Vec3)>,
     /// What the probe says of it.
     pub probe: Option<String>,
 }
 
-/// Picks the point under the cursor when the cursor, the lenses or the scene changed.
+/// Picks the point under the cursor when the cursor, the camera, the lenses or the
+/// scene changed.
 pub fn pick_under_cursor(
     windows: Query<&Window, With<PrimaryWindow>>,
     pointer: Res<PointerInViewport>,
     cams: Query<(&Camera, &ViewLenses), With<MainCamera>>,
     regions: Res<SceneRegions>,
-    datasets: Query<&crate::dataset::Dataset>,
+    datasets: Query<&Dataset>,
     mut under: ResMut<UnderCursor>,
 ) {
     let (Ok(window), Ok((camera, lenses))) = (windows.single(), cams.single()) else { return };
@@ -47,8 +52,10 @@ pub fn pick_under_cursor(
         }
         return;
     };
-    let stale =
-        regions.is_changed() || under.picked_for.as_ref().is_none_or(|(at, picked)| at.distance(cursor) > 0.5 || *picked != lenses.lenses);
+    let stale = regions.is_changed()
+        || under.picked_for.as_ref().is_none_or(|(at, camera, shown, picked)| {
+            at.distance(cursor) > 0.5 || *camera != lenses.camera || *shown != lenses.screen || *picked != lenses.lenses
+        });
     if !stale {
         return;
     }
@@ -58,55 +65,52 @@ pub fn pick_under_cursor(
         let region = regions.scene.regions.get(h.region)?;
         Some((region.volume, region.world_to_voxel.transform_point3(h.position)))
     });
-    // (Label names from the dataset's own table: a label volume's.)
-    let name = |volume: usize, id: u32| {
-        let dataset = datasets.get(*regions.datasets.get(volume)?).ok()?;
-        Some(dataset.labels.as_ref()?.name(id).to_string())
-    };
-    under.probe = hit.as_ref().and_then(|h| describe(&regions, h, name));
-    under.picked_for = Some((cursor, lenses.lenses.clone()));
+    under.point = hit.as_ref().and_then(|h| dataset_point(&regions, h));
+    under.probe = hit.as_ref().and_then(|h| {
+        let (entity, _) = dataset_point(&regions, h)?;
+        describe(&regions, h, datasets.get(entity).ok()?)
+    });
+    under.picked_for = Some((cursor, lenses.camera, lenses.screen, lenses.lenses.clone()));
 }
 
-/// "name · voxel (i, j, k): value units, label id name" of the voxel nearest a hit
-/// (`name(volume, id)`: a label's name).
-pub fn describe(regions: &SceneRegions, hit: &Hit, name: impl Fn(usize, u32) -> Option<String>) -> Option<String> {
-    let scene = &regions.scene;
-    let region = scene.regions.get(hit.region)?;
-    let volume = scene.volumes.get(region.volume)?;
+/// The dataset of a hit and the point in the dataset's own frame: through the region's
+/// own map, so a point on a moved part or in a window is where the data is.
+pub fn dataset_point(regions: &SceneRegions, hit: &Hit) -> Option<(Entity, Vec3)> {
+    let region = regions.scene.regions.get(hit.region)?;
+    let volume = regions.scene.volumes.get(region.volume)?;
+    let dataset = *regions.datasets.get(region.volume)?;
     let q = region.world_to_voxel.transform_point3(hit.position);
+    Some((dataset, volume.grid.index_to_world().transform_point3(q)))
+}
+
+/// "name · voxel (i, j, k): value units, label id name" of the dataset's own voxel
+/// nearest a hit (the dataset's volume, not the one the GPU draws, which may be halved).
+pub fn describe(regions: &SceneRegions, hit: &Hit, dataset: &Dataset) -> Option<String> {
+    let (_, point) = dataset_point(regions, hit)?;
+    let volume = &dataset.volume;
+    let q = volume.grid.world_to_index().transform_point3(point);
     let voxel = q.round().max(Vec3::ZERO).min(volume.dims().as_vec3() - 1.0).as_uvec3();
     let value = volume.values.to_real(volume.code(voxel.x, voxel.y, voxel.z) as f64);
     let units = volume.values.units.as_deref().map(|u| format!(" {u}")).unwrap_or_default();
-    let label = crate::reference::label_at(scene, hit)
-        .map(|id| match name(region.volume, id) {
-            Some(n) => format!(", label {id} {n}"),
-            None => format!(", label {id}"),
-        })
-        .unwrap_or_default();
-    Some(format!("{} · voxel ({}, {}, {}): {value}{units}{label}", volume.name, voxel.x, voxel.y, voxel.z))
+    // A label volume's label is its value; a segmented one's, its segmentation's there.
+    let label = match &dataset.labels {
+        Some(table) => Some(format!(", label {} {}", value, table.name(value.round().max(0.0) as u32))),
+        None => crate::reference::label_at(&regions.scene, hit).map(|id| format!(", label {id}")),
+    };
+    Some(format!("{} · voxel ({}, {}, {}): {value}{units}{}", volume.name, voxel.x, voxel.y, voxel.z, label.unwrap_or_default()))
 }
 
-/// The probe at the top left of the 3D view (the slice views' own probe, when the cursor
-/// is over a slice, takes its place).
-pub fn probe_text(
-    mut contexts: EguiContexts,
-    under: Res<UnderCursor>,
-    views: Res<SliceViews>,
-    windows: Query<&Window, With<PrimaryWindow>>,
-    cams: Query<&Camera, With<MainCamera>>,
-) -> Result {
-    let Some(text) = under.probe.as_ref().filter(|_| !(views.show && views.probe.is_some())) else { return Ok(()) };
-    let (Ok(window), Ok(camera)) = (windows.single(), cams.single()) else { return Ok(()) };
-    let ctx = contexts.ctx_mut()?.clone();
-    let (origin, _) = viewport_logical(camera, window);
+/// The probe's text at the top left of the 3D view (`free`): a slice's voxel while the
+/// cursor is over a slice view, else the 3D view's.
+pub fn probe_overlay(ctx: &egui::Context, free: egui::Rect, text: Option<&str>) {
+    let Some(text) = text else { return };
     ctx.layer_painter(egui::LayerId::new(egui::Order::Foreground, egui::Id::new("probe"))).text(
-        egui::pos2(origin.x + 8.0, origin.y + 8.0),
+        free.left_top() + egui::vec2(8.0, 8.0),
         egui::Align2::LEFT_TOP,
         text,
         egui::FontId::monospace(13.0),
         egui::Color32::WHITE,
     );
-    Ok(())
 }
 
 #[cfg(test)]
@@ -115,22 +119,51 @@ mod tests {
     use crate::scene::SceneFile;
     use crate::scene::load::{load_datasets, render_scene};
 
+    /// A one-dataset scene's regions and its dataset component.
+    fn scene_of(text: &str) -> (SceneRegions, Dataset) {
+        let scene = SceneFile::parse(text, "t").unwrap();
+        let datasets = load_datasets(&scene, std::path::Path::new(".")).unwrap();
+        let regions = SceneRegions { scene: render_scene(&datasets, &scene), datasets: vec![Entity::from_raw_u32(7).unwrap()] };
+        (regions, datasets[0].component())
+    }
+
+    /// A ray along −x through the middle of the dataset, from far away, in the world.
+    fn ray_through(d: &Dataset, shift: Vec3) -> crate::region::Ray {
+        let grid = &d.volume.grid;
+        let centre = grid.index_to_world().transform_point3((grid.dims.as_vec3() - 1.0) * 0.5) + shift;
+        crate::region::Ray { origin: centre + Vec3::new(1000.0, 0.0, 0.0), dir: Vec3::NEG_X }
+    }
+
+    #[test]
+    fn a_surface_point_is_on_the_sphere_in_the_datasets_own_frame() {
+        // The sphere phantom (radius 0.35·n voxels), moved 500 mm along x: the ray meets
+        // the surface one radius before the centre, and the point comes back in the
+        // dataset's frame, not the world's.
+        let (regions, d) = scene_of("(datasets: [(source: Phantom(kind: sphere, resolution: 40), translation: (500, 0, 0))])");
+        let grid = &d.volume.grid;
+        let centre = grid.index_to_world().transform_point3((grid.dims.as_vec3() - 1.0) * 0.5);
+        let radius = 0.35 * 40.0 * grid.spacing.x;
+        let hit = crate::reference::pick(&regions.scene, ray_through(&d, Vec3::new(500.0, 0.0, 0.0))).unwrap().expect("the sphere");
+        let (dataset, point) = dataset_point(&regions, &hit).unwrap();
+        assert_eq!(dataset, regions.datasets[0]);
+        assert!((point.distance(centre) - radius).abs() < 2.0 * grid.spacing.x, "{point} from {centre}: {radius}");
+        assert!(point.x > centre.x, "on the side facing the eye");
+        let miss = ray_through(&d, Vec3::new(500.0, 0.0, 3.0 * radius));
+        assert!(crate::reference::pick(&regions.scene, miss).unwrap().is_none());
+    }
+
     #[test]
     fn the_probe_names_the_voxel_its_value_and_its_label() {
-        // The head phantom's labels, seen along −x through the middle: the first visible
-        // voxel is a labelled one; the probe gives its indices, its value (the label id)
-        // and the name the closure gives.
-        let scene = SceneFile::parse("(datasets: [(source: PhantomLabels(resolution: 32), appearance: (labels: Some(())))])", "t").unwrap();
-        let datasets = load_datasets(&scene, std::path::Path::new(".")).unwrap();
-        let regions = SceneRegions { scene: render_scene(&datasets, &scene), datasets: vec![Entity::from_raw_u32(1).unwrap()] };
-        let grid = &datasets[0].volume.grid;
-        let centre = grid.index_to_world().transform_point3((grid.dims.as_vec3() - 1.0) * 0.5);
-        let ray = crate::region::Ray { origin: centre + Vec3::new(1000.0, 0.0, 0.0), dir: Vec3::NEG_X };
-        let hit = crate::reference::pick(&regions.scene, ray).unwrap().expect("the head is hit");
-        let text = describe(&regions, &hit, |volume, id| (volume == 0).then(|| format!("tissue{id}"))).unwrap();
-        let q = regions.scene.regions[hit.region].world_to_voxel.transform_point3(hit.position).round().as_uvec3();
-        let id = datasets[0].volume.code(q.x, q.y, q.z);
+        // The head phantom's labels: the first visible voxel along the ray is labelled;
+        // the probe gives its indices, its value (the label id) and its name.
+        let (regions, d) = scene_of("(datasets: [(source: PhantomLabels(resolution: 32), appearance: (labels: Some(())))])");
+        let hit = crate::reference::pick(&regions.scene, ray_through(&d, Vec3::ZERO)).unwrap().expect("the head is hit");
+        let text = describe(&regions, &hit, &d).unwrap();
+        let (_, point) = dataset_point(&regions, &hit).unwrap();
+        let q = d.volume.grid.world_to_index().transform_point3(point).round().as_uvec3();
+        let id = d.volume.code(q.x, q.y, q.z);
+        let name = d.labels.as_ref().unwrap().name(id as u32).to_string();
         assert!(text.contains(&format!("voxel ({}, {}, {}): {id}", q.x, q.y, q.z)), "{text}");
-        assert!(id > 0 && text.ends_with(&format!("label {id} tissue{id}")), "{text}");
+        assert!(id > 0 && text.ends_with(&format!("label {id} {name}")), "{text}");
     }
 }
