@@ -117,14 +117,21 @@ fn count_in(img: &image::RgbaImage, left: u32, top: u32, f: &dyn Fn(&image::Rgba
     (top..h).flat_map(|y| (left..w).map(move |x| (x, y))).filter(|&(x, y)| f(img.get_pixel(x, y))).count()
 }
 
-/// The app's screenshot of `scene` with `options` after 4 frames (in Xvfb, 900×600).
-fn app_screenshot_with(scene: &std::path::Path, options: &[&str], shot: &std::path::Path) -> image::RgbaImage {
+/// The app on `scene` (with `options`) in Xvfb on a `screen`, its window `window`: the
+/// screenshot it writes to `shot` after `frames` frames (its settings beside `shot`).
+fn run_app(
+    scene: &std::path::Path,
+    options: &[&str],
+    frames: u32,
+    (screen, window): (&str, &str),
+    shot: &std::path::Path,
+) -> image::RgbaImage {
     let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .args(["-a", "-s", &format!("-screen 0 {screen}x24")])
         .arg(env!("CARGO_BIN_EXE_focal"))
         .arg(scene)
         .args(options)
-        .args(["--frames", "4", "--window", "900x600", "--screenshot"])
+        .args(["--frames", &frames.to_string(), "--window", window, "--screenshot"])
         .arg(shot)
         .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
         .env("FOCAL_CONFIG_DIR", config_dir(shot))
@@ -134,20 +141,14 @@ fn app_screenshot_with(scene: &std::path::Path, options: &[&str], shot: &std::pa
     image::open(shot).unwrap().to_rgba8()
 }
 
+/// The app's screenshot of `scene` with `options` after 4 frames (in Xvfb, 900×600).
+fn app_screenshot_with(scene: &std::path::Path, options: &[&str], shot: &std::path::Path) -> image::RgbaImage {
+    run_app(scene, options, 4, ("1024x768", "900x600"), shot)
+}
+
 /// The app's screenshot of `scene` after `frames` frames (in Xvfb).
 fn app_screenshot(scene: &std::path::Path, frames: u32, shot: &std::path::Path) -> image::RgbaImage {
-    let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1024x768x24"])
-        .arg(env!("CARGO_BIN_EXE_focal"))
-        .arg(scene)
-        .args(["--frames", &frames.to_string(), "--window", "800x500", "--screenshot"])
-        .arg(shot)
-        .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
-        .env("FOCAL_CONFIG_DIR", config_dir(shot))
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    image::open(shot).unwrap().to_rgba8()
+    run_app(scene, &[], frames, ("1024x768", "800x500"), shot)
 }
 
 #[test]
@@ -481,18 +482,7 @@ fn the_app_remembers_its_panel_width_and_the_files_it_opened() {
     std::fs::create_dir_all(&config).unwrap();
     std::fs::write(config.join("settings.ron"), "(panel_width: Some(450.0))").unwrap();
     let file = common::data("ct/fuel.nii.gz");
-    let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1280x800x24"])
-        .arg(env!("CARGO_BIN_EXE_focal"))
-        .arg(&file)
-        .args(["--frames", "2", "--window", "1200x700", "--screenshot"])
-        .arg(&shot)
-        .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
-        .env("FOCAL_CONFIG_DIR", &config)
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let img = image::open(&shot).unwrap().to_rgba8();
+    let img = run_app(&file, &[], 2, ("1280x800", "1200x700"), &shot);
     let left = viewport_left(&img).expect("the viewport's edge");
     assert!((440..=462).contains(&left), "the panel is {left} px wide, not the 450 remembered ({})", shot.display());
     // The file is the first recent one, the width still remembered.

@@ -9,6 +9,7 @@
 //! each panel, gizmo and viewport tool has its file.
 
 pub mod app;
+pub mod camera_panel;
 pub mod clip_gizmo;
 pub mod clip_panel;
 pub mod explode_overlay;

@@ -15,7 +15,7 @@ use super::{lenses, objects_panel, tf_editor};
 use crate::context::{ContextParams, Power};
 use crate::dataset::{Dataset, GpuVolume, SceneLight, SceneRegions};
 use crate::interactive::InteractiveResolution;
-use crate::region::{Light, Lookup, Mode, View};
+use crate::region::{Light, Lookup, Mode};
 use crate::transfer::presets;
 
 fn dataset_row(entity: Entity, d: &Dataset, t: &Transform) -> super::windows_panel::DatasetRow {
@@ -254,9 +254,9 @@ pub fn ui(
             });
             egui::CollapsingHeader::new("Camera").default_open(true).show(ui, |ui| {
                 if let Ok((mut orbit, _, adapt)) = cams.single_mut() {
-                    camera_panel(ui, &mut orbit, scene_bounds(&regions));
+                    super::camera_panel::camera_panel(ui, &mut orbit, scene_bounds(&regions));
                     if let Some(mut adapt) = adapt {
-                        interaction_panel(ui, &mut adapt);
+                        super::camera_panel::interaction_panel(ui, &mut adapt);
                     }
                 }
             });
@@ -585,50 +585,6 @@ fn rendering_panel(ui: &mut Ui, d: &mut Dataset, state: &mut AppState, light: &m
         "Under a lens, streamed data steps along the ray at the context's rate: native voxels across, \
          about the cost of no lens, but structures thin along the ray may be missed",
     );
-}
-
-/// The view's interactive resolution: on or off, the frame time it holds while moving.
-fn interaction_panel(ui: &mut Ui, adapt: &mut InteractiveResolution) {
-    ui.separator();
-    ui.checkbox(&mut adapt.enabled, "fewer pixels while moving").on_hover_text(
-        "While the camera, a lens, a window or a slider moves, the rays are drawn at a lower \
-         resolution that holds the frame time below, then refined to every pixel when it rests",
-    );
-    ui.add_enabled(
-        adapt.enabled,
-        egui::Slider::new(&mut adapt.target_ms, 16.0..=500.0).logarithmic(true).suffix(" ms").text("frame time while moving"),
-    );
-}
-
-fn camera_panel(ui: &mut Ui, orbit: &mut OrbitCamera, bounds: (Vec3, Vec3)) {
-    ui.horizontal_wrapped(|ui| {
-        for (label, view) in [
-            ("front", View::Anterior),
-            ("back", View::Posterior),
-            ("left", View::Left),
-            ("right", View::Right),
-            ("top", View::Superior),
-            ("bottom", View::Inferior),
-            ("oblique", View::Oblique),
-        ] {
-            if ui.button(label).clicked() {
-                orbit.frame(view, bounds.0, bounds.1, 1.0);
-            }
-        }
-    });
-    ui.horizontal(|ui| {
-        if ui.button("reset").clicked() {
-            orbit.frame(View::Oblique, bounds.0, bounds.1, 1.0);
-        }
-        ui.checkbox(&mut orbit.orthographic, "orthographic");
-        let mut fly = orbit.fly;
-        if ui.checkbox(&mut fly, "fly-through (V)").changed() {
-            super::orbit::toggle_fly(orbit, bounds);
-        }
-    });
-    ui.add(egui::Slider::new(&mut orbit.fov_deg, 10.0..=90.0).text("field of view °"));
-    ui.add(egui::Slider::new(&mut orbit.azimuth_deg, 0.0..=360.0).text("azimuth °"));
-    ui.add(egui::Slider::new(&mut orbit.elevation_deg, -89.0..=89.0).text("elevation °"));
 }
 
 fn mode_name(m: Mode) -> &'static str {
