@@ -1,17 +1,25 @@
-//! Throws truncated and corrupted versions of every real file at the readers: each
-//! must return (a volume or an error) without panicking, within a time limit, and
-//! without any single allocation larger than [`MAX_ALLOCATION`].
+//! Throws truncated and corrupted versions of every real file, and of files written
+//! from them in the other formats and encodings Focal reads, at the readers and at the
+//! scene parser: each must return (a volume, a scene or an error) without panicking,
+//! within a time limit, and without any single allocation larger than
+//! [`MAX_ALLOCATION`]. Every input that ever failed is kept in `tests/fuzz_regressions`
+//! and read again by [`regressions`]. Each test prints how many inputs it tried
+//! (docs/reliability.md sums them). Long runs: the `cargo fuzz` targets in `fuzz/`.
 
 mod common;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::Path;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::time::Duration;
 
 use common::{data, scratch};
-use focal::volume::readers::{ReadOptions, label_table, read_volume};
+use focal::scene::file::SceneFile;
+use focal::scene::load::read_scene;
+use focal::volume::Voxels;
+use focal::volume::readers::{RawSpec, ReadOptions, label_table, read_volume};
 
 /// Largest single allocation a reader may make on these inputs (the largest real file
 /// decodes to 32 MB).
@@ -57,7 +65,9 @@ impl Rng {
 }
 
 /// Mutated copies of `bytes`: truncations, byte overwrites (biased to the header),
-/// and for text headers, numbers replaced by huge or negative ones.
+/// ranges deleted, duplicated or moved (what a bad copy or a hand edit does to a text
+/// header or a scene file), and for text headers, numbers replaced by huge, negative or
+/// non-finite ones.
 fn mutations(bytes: &[u8], seed: u64, count: usize) -> Vec<(String, Vec<u8>)> {
     let mut rng = Rng(seed | 1);
     let n = bytes.len();
@@ -82,11 +92,34 @@ fn mutations(bytes: &[u8], seed: u64, count: usize) -> Vec<(String, Vec<u8>)> {
         }
         out.push((format!("corruption {i} ({edits} bytes)"), b));
     }
-    // Text headers: replace a number with a huge or negative one.
+    for i in 0..count / 2 {
+        let (a, len) = (rng.below(header), 1 + rng.below(64));
+        let range = a..(a + len).min(n);
+        let mut b = bytes.to_vec();
+        let what = match rng.below(3) {
+            0 => {
+                b.drain(range.clone());
+                "deleted"
+            }
+            1 => {
+                let copy = b[range.clone()].to_vec();
+                b.splice(range.end..range.end, copy);
+                "duplicated"
+            }
+            _ => {
+                let moved: Vec<u8> = b.drain(range.clone()).collect();
+                let to = rng.below(b.len() + 1);
+                b.splice(to..to, moved);
+                "moved"
+            }
+        };
+        out.push((format!("bytes {}..{} {what} ({i})", range.start, range.end), b));
+    }
+    // Text headers: replace a number with a huge, negative or non-finite one.
     let text_end = bytes.iter().take(4096).position(|&c| c == 0 || c > 127).unwrap_or(n.min(4096));
     let digits: Vec<usize> = (0..text_end).filter(|&i| bytes[i].is_ascii_digit() && (i == 0 || !bytes[i - 1].is_ascii_digit())).collect();
     for (k, &at) in digits.iter().enumerate().take(60) {
-        for repl in ["4294967295", "-7", "99999999999999999999", "0"] {
+        for repl in ["4294967295", "-7", "99999999999999999999", "0", "1e39", "NaN"] {
             let end = (at..text_end).find(|&i| !bytes[i].is_ascii_digit()).unwrap_or(text_end);
             let mut b = bytes[..at].to_vec();
             b.extend_from_slice(repl.as_bytes());
@@ -97,16 +130,52 @@ fn mutations(bytes: &[u8], seed: u64, count: usize) -> Vec<(String, Vec<u8>)> {
     out
 }
 
-fn run_case(path: &Path, what: &str) -> Result<(), String> {
+/// What a fuzzed file is given to.
+#[derive(Clone, Copy)]
+enum Reader {
+    /// `read_volume` (and the label-table reader for `.txt` and `.lut`).
+    Volume,
+    /// A headerless file with the layout of a fixed spec.
+    Raw(&'static str),
+    /// The scene parser and its checks, then what a valid scene's animation and frames
+    /// compute before any dataset is loaded.
+    Scene,
+}
+
+fn read_with(reader: Reader, p: &Path) {
+    match reader {
+        Reader::Volume => {
+            let _ = read_volume(p, &ReadOptions::default());
+            if p.extension().is_some_and(|e| e == "txt" || e == "lut") {
+                let _ = label_table::read(p);
+            }
+        }
+        Reader::Raw(spec) => {
+            if let Ok(spec) = spec.parse::<RawSpec>() {
+                let _ = read_volume(p, &ReadOptions { raw: Some(spec), ..Default::default() });
+            }
+        }
+        Reader::Scene => {
+            if let Ok(scene) = read_scene(p) {
+                if let Some(a) = &scene.animation {
+                    let _ = focal::scene::movie::animation_frames(a, &scene, "fuzz");
+                }
+                let _ = focal::scene::movie::turntable(scene, 3, 30.0, 20.0, false, 1.0);
+            }
+        }
+    }
+}
+
+/// Inputs tried by this test binary.
+static TRIED: AtomicUsize = AtomicUsize::new(0);
+/// One case at a time: the allocation counter is global.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+fn run_case(path: &Path, reader: Reader, what: &str) -> Result<(), String> {
     let (tx, rx) = mpsc::channel();
     let p = path.to_path_buf();
     std::thread::spawn(move || {
-        let r = std::panic::catch_unwind(|| {
-            let _ = read_volume(&p, &ReadOptions::default());
-            if p.extension().is_some_and(|e| e == "txt" || e == "lut") {
-                let _ = label_table::read(&p);
-            }
-        });
+        let r = std::panic::catch_unwind(|| read_with(reader, &p));
         let _ = tx.send(r.is_ok());
     });
     match rx.recv_timeout(TIME_LIMIT) {
@@ -116,36 +185,94 @@ fn run_case(path: &Path, what: &str) -> Result<(), String> {
     }
 }
 
+/// Writes each mutation of `bytes` to `dir/name` (`name` may name a file inside a
+/// folder that `dir` is, as an OME-Zarr store's metadata is) and reads it with
+/// `reader`, restoring the original afterwards. A failing input is kept beside the
+/// scratch folder under `failed-…` for `tests/fuzz_regressions`.
+fn fuzz_bytes(label: &str, dir: &Path, name: &str, bytes: &[u8], reader: Reader, seed: u64, count: usize) -> Vec<String> {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let p = dir.join(name);
+    let mut failures = Vec::new();
+    for (k, (what, b)) in mutations(bytes, seed, count).into_iter().enumerate() {
+        std::fs::write(&p, &b).unwrap();
+        LARGEST.store(0, Ordering::Relaxed);
+        let mut failed = run_case(&p, reader, &format!("{label}: {what}")).err();
+        let largest = LARGEST.load(Ordering::Relaxed);
+        if largest > MAX_ALLOCATION {
+            failed = Some(format!("{label}: {what}: allocated {largest} bytes at once"));
+        }
+        TRIED.fetch_add(1, Ordering::Relaxed);
+        if let Some(e) = failed {
+            let keep = dir.with_file_name(format!("failed-{k}-{}", name.replace('/', "_")));
+            let _ = std::fs::write(&keep, &b);
+            failures.push(format!("{e} (kept as {})", keep.display()));
+        }
+    }
+    std::fs::write(&p, bytes).unwrap();
+    failures
+}
+
 fn fuzz(rel: &str, seed: u64, count: usize) {
     let src = data(rel);
     let bytes = std::fs::read(&src).unwrap();
-    let name = src.file_name().unwrap().to_string_lossy().into_owned();
+    fuzz_file(rel, &bytes, src.file_name().unwrap().to_str().unwrap(), Reader::Volume, seed, count);
+}
+
+/// Fuzzes `bytes` saved as `name` in a scratch folder of its own.
+fn fuzz_file(label: &str, bytes: &[u8], name: &str, reader: Reader, seed: u64, count: usize) {
     let dir = scratch(&format!("fuzz-{}", name.replace('.', "_")));
-    let mut failures = Vec::new();
-    for (what, b) in mutations(&bytes, seed, count) {
-        let p = dir.join(&name);
-        std::fs::write(&p, &b).unwrap();
-        LARGEST.store(0, Ordering::Relaxed);
-        if let Err(e) = run_case(&p, &what) {
-            failures.push(e);
-        }
-        let largest = LARGEST.load(Ordering::Relaxed);
-        if largest > MAX_ALLOCATION {
-            failures.push(format!("{what}: allocated {largest} bytes at once"));
-        }
-    }
-    assert!(failures.is_empty(), "{rel}:\n{}", failures.join("\n"));
+    let failures = fuzz_bytes(label, &dir, name, bytes, reader, seed, count);
+    report(label, failures);
+}
+
+fn report(label: &str, failures: Vec<String>) {
+    eprintln!("{label}: {} inputs tried by this test binary so far", TRIED.load(Ordering::Relaxed));
+    assert!(failures.is_empty(), "{label}:\n{}", failures.join("\n"));
+}
+
+/// The fuel CT's voxels (64×33×32, uint8), for files written in other formats.
+fn fuel() -> Vec<u8> {
+    let v = read_volume(&data("ct/fuel.nii.gz"), &ReadOptions::default()).unwrap();
+    let Voxels::U8(codes) = v.voxels else { panic!("fuel is 8-bit") };
+    codes
+}
+
+fn gunzip(bytes: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(bytes), &mut out).unwrap();
+    out
+}
+
+fn gzip(bytes: &[u8]) -> Vec<u8> {
+    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    std::io::Write::write_all(&mut e, bytes).unwrap();
+    e.finish().unwrap()
 }
 
 #[test]
 fn nifti() {
     fuzz("ct/fuel.nii.gz", 1, 60);
     fuzz("mri/ch2.nii.gz", 2, 25);
+    // Uncompressed, and the gzip stream itself corrupted inside.
+    let plain = gunzip(&std::fs::read(data("ct/fuel.nii.gz")).unwrap());
+    fuzz_file("fuel.nii", &plain, "fuel.nii", Reader::Volume, 11, 60);
 }
 
 #[test]
 fn nrrd() {
     fuzz("mri/FLAIR.nrrd", 3, 40);
+    // The other encodings: raw, ascii, gzip, each with its header fuzzed.
+    let codes = fuel();
+    let head = |encoding: &str| {
+        format!("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 64 33 32\nencoding: {encoding}\nspace: RAS\nspace directions: (1,0,0) (0,1,0) (0,0,2)\nspace origin: (-5,3,1)\n\n")
+            .into_bytes()
+    };
+    let ascii: String = codes.iter().map(|c| format!("{c} ")).collect();
+    for (k, (encoding, body)) in [("raw", codes.clone()), ("ascii", ascii.into_bytes()), ("gzip", gzip(&codes))].into_iter().enumerate() {
+        let mut file = head(encoding);
+        file.extend(body);
+        fuzz_file(&format!("fuel as {encoding} NRRD"), &file, &format!("fuel_{encoding}.nrrd"), Reader::Volume, 30 + k as u64, 40);
+    }
 }
 
 #[test]
@@ -169,4 +296,145 @@ fn dicom() {
 fn label_tables() {
     fuzz("labels/aal.nii.txt", 9, 40);
     fuzz("labels/aal.nii.lut", 10, 20);
+}
+
+#[test]
+fn volvis_dat_and_raw() {
+    let codes = fuel();
+    let dir = scratch("fuzz-dat");
+    std::fs::write(dir.join("fuel.raw"), &codes).unwrap();
+    // The text header beside its raw file, fuzzed.
+    let text = b"ObjectFileName: fuel.raw\nTaggedFileName: ---\nResolution: 64 33 32\nSliceThickness: 1 1 2\nFormat: UCHAR\n";
+    let mut failures = fuzz_bytes("volvis .dat text header", &dir, "fuel.dat", text, Reader::Volume, 12, 60);
+    // TU Wien's binary .dat: three u16 dims, then u16 voxels.
+    let mut bin: Vec<u8> = [64u16, 33, 32].iter().flat_map(|d| d.to_le_bytes()).collect();
+    bin.extend(codes.iter().flat_map(|&c| (c as u16 * 16).to_le_bytes()));
+    failures.extend(fuzz_bytes("binary .dat", &dir, "fuel_bin.dat", &bin, Reader::Volume, 13, 60));
+    // Headerless: the file fuzzed under a fixed spec, and specs fuzzed over the file.
+    failures.extend(fuzz_bytes("raw", &dir, "fuel2.raw", &codes, Reader::Raw("64x33x32:uint8:s=1x1x2"), 14, 30));
+    for (k, (what, spec)) in mutations(b"64x33x32:uint16:be:s=1x1x2", 15, 80).into_iter().enumerate() {
+        let spec = String::from_utf8_lossy(&spec).into_owned();
+        let leaked: &'static str = Box::leak(spec.into_boxed_str());
+        LARGEST.store(0, Ordering::Relaxed);
+        if let Err(e) = run_case(&dir.join("fuel.raw"), Reader::Raw(leaked), &format!("raw spec {what} ({k}): {leaked:?}")) {
+            failures.push(e);
+        }
+        TRIED.fetch_add(1, Ordering::Relaxed);
+    }
+    report("volvis .dat and raw", failures);
+}
+
+#[test]
+fn scene_files() {
+    // Every example scene, parsed and checked (its datasets are not loaded).
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
+    let mut names: Vec<_> = std::fs::read_dir(&examples).unwrap().filter_map(|e| e.ok()).map(|e| e.path()).collect();
+    names.retain(|p| p.extension().is_some_and(|e| e == "ron"));
+    names.sort();
+    let dir = scratch("fuzz-scenes");
+    let mut failures = Vec::new();
+    for (k, p) in names.iter().enumerate() {
+        let text = std::fs::read(p).unwrap();
+        let name = p.file_name().unwrap().to_str().unwrap();
+        assert!(SceneFile::parse(&String::from_utf8_lossy(&text), name).is_ok(), "{name} parses unchanged");
+        failures.extend(fuzz_bytes(name, &dir, name, &text, Reader::Scene, 100 + k as u64, 24));
+    }
+    report("scene files", failures);
+}
+
+#[test]
+fn ome_zarr_metadata_and_chunks() {
+    use focal::volume::convert::ome_zarr::{WriteOptions, ZarrVersion, write};
+    let volume = read_volume(&data("ct/fuel.nii.gz"), &ReadOptions::default()).unwrap();
+    let mut failures = Vec::new();
+    let stores = [
+        ("v3 sharded", WriteOptions { chunk: 16, shard: Some(2), ..Default::default() }),
+        ("v2", WriteOptions { chunk: 16, version: ZarrVersion::V2, ..Default::default() }),
+    ];
+    for (k, (what, opts)) in stores.into_iter().enumerate() {
+        let dir = scratch(&format!("fuzz-zarr-{k}"));
+        let store = dir.join("fuel.zarr");
+        write(&volume, &store, &opts, &|_, _| {}).unwrap();
+        // Its metadata files and the first chunk (or shard) of each level.
+        let mut files: Vec<String> = Vec::new();
+        let mut stack = vec![store.clone()];
+        while let Some(d) = stack.pop() {
+            let mut entries: Vec<_> = std::fs::read_dir(&d).unwrap().filter_map(|e| e.ok()).map(|e| e.path()).collect();
+            entries.sort();
+            let mut chunk_taken = false;
+            for e in entries {
+                let rel = e.strip_prefix(&dir).unwrap().to_str().unwrap().to_owned();
+                let file = e.file_name().unwrap().to_str().unwrap();
+                if e.is_dir() {
+                    stack.push(e);
+                } else if file.starts_with('.') || file.ends_with(".json") {
+                    files.push(rel);
+                } else if !chunk_taken {
+                    files.push(rel);
+                    chunk_taken = true;
+                }
+            }
+        }
+        assert!(files.len() >= 4, "{what}: {files:?}");
+        for (i, rel) in files.iter().enumerate() {
+            let bytes = std::fs::read(dir.join(rel)).unwrap();
+            let label = format!("OME-Zarr {what} {rel}");
+            failures.extend(fuzz_store(&label, &dir, rel, &bytes, 200 + (k * 50 + i) as u64));
+        }
+    }
+    report("OME-Zarr", failures);
+}
+
+/// Fuzzes one file of the store in `dir` (read through the store's folder).
+fn fuzz_store(label: &str, dir: &Path, rel: &str, bytes: &[u8], seed: u64) -> Vec<String> {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let target = dir.join(rel);
+    let store = dir.join("fuel.zarr");
+    let mut failures = Vec::new();
+    for (k, (what, b)) in mutations(bytes, seed, 12).into_iter().enumerate().take(60) {
+        std::fs::write(&target, &b).unwrap();
+        LARGEST.store(0, Ordering::Relaxed);
+        let mut failed = run_case(&store, Reader::Volume, &format!("{label}: {what}")).err();
+        let largest = LARGEST.load(Ordering::Relaxed);
+        if largest > MAX_ALLOCATION {
+            failed = Some(format!("{label}: {what}: allocated {largest} bytes at once"));
+        }
+        TRIED.fetch_add(1, Ordering::Relaxed);
+        if let Some(e) = failed {
+            let keep = dir.join(format!("failed-{k}-{}", rel.replace('/', "_")));
+            let _ = std::fs::write(&keep, &b);
+            failures.push(format!("{e} (kept as {})", keep.display()));
+        }
+    }
+    std::fs::write(&target, bytes).unwrap();
+    failures
+}
+
+/// Inputs that once failed, each read again as the fuzzer read it: a volume, or a
+/// scene where the file ends in `.ron`.
+#[test]
+fn regressions() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_regressions");
+    let mut failures = Vec::new();
+    let mut count = 0;
+    for entry in std::fs::read_dir(&root).unwrap().filter_map(|e| e.ok()) {
+        let p = entry.path();
+        let reader = match p.extension().and_then(|e| e.to_str()) {
+            Some("ron") => Reader::Scene,
+            Some("md") => continue,
+            _ => Reader::Volume,
+        };
+        let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+        LARGEST.store(0, Ordering::Relaxed);
+        if let Err(e) = run_case(&p, reader, &p.display().to_string()) {
+            failures.push(e);
+        }
+        let largest = LARGEST.load(Ordering::Relaxed);
+        if largest > MAX_ALLOCATION {
+            failures.push(format!("{}: allocated {largest} bytes at once", p.display()));
+        }
+        count += 1;
+    }
+    assert!(count > 0, "no regression cases in {}", root.display());
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -7,6 +7,7 @@
 //! memory. Metadata is parsed by [`metadata`].
 
 mod chunks;
+pub mod guard;
 pub mod metadata;
 pub mod source;
 
@@ -48,9 +49,15 @@ pub fn open(path: &Path) -> Result<ZarrSource, ReadError> {
     } else {
         Arc::new(FilesystemStore::new(path).map_err(|e| fail(Problem::Io(std::io::Error::other(e.to_string()))))?)
     };
+    let guarded = Arc::new(guard::Guarded::new(store));
+    let store: ReadableStorage = guarded.clone();
     let group = Group::open(store.clone(), "/").map_err(|e| fail(Problem::Malformed(format!("not a readable Zarr group: {e}"))))?;
     let meta = metadata::parse(group.attributes()).map_err(|e| fail(Problem::Malformed(e)))?;
-    ZarrSource::open(store, path, &meta).map_err(|e| fail(Problem::Malformed(e)))
+    let source = ZarrSource::open(store, path, &meta).map_err(|e| fail(Problem::Malformed(e)))?;
+    for (prefix, limit) in source.blosc_arrays() {
+        guarded.guard(prefix, limit);
+    }
+    Ok(source)
 }
 
 /// Reads one level of the image at `path` into memory (the finest within

@@ -78,6 +78,21 @@ pub struct ZarrSource {
 }
 
 impl ZarrSource {
+    /// The key prefix and the largest decoded chunk in bytes (its shape times 8, the
+    /// widest sample type) of each level whose codecs include blosc ([`super::guard`]).
+    pub fn blosc_arrays(&self) -> Vec<(String, u64)> {
+        self.levels
+            .iter()
+            .filter(|l| serde_json::to_string(l.array.metadata()).is_ok_and(|m| m.contains("\"blosc\"")))
+            .filter_map(|l| {
+                let shape = l.array.chunk_shape(&vec![0; l.fixed.len()]).ok()?;
+                let elements = shape.iter().map(|c| c.get()).fold(1u64, u64::saturating_mul);
+                let prefix = format!("{}/", l.array.path().as_str().trim_matches('/'));
+                Some((prefix, elements.saturating_mul(8)))
+            })
+            .collect()
+    }
+
     /// Opens the image group `meta` describes in `store` (`root` names it in messages).
     pub fn open(store: ReadableStorage, root: &Path, meta: &Multiscale) -> Result<ZarrSource, String> {
         let mut warnings = meta.warnings.clone();
