@@ -438,3 +438,101 @@ fn regressions() {
     assert!(count > 0, "no regression cases in {}", root.display());
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Every format with a header that claims 10¹² voxels (10 000 along each axis; 65 535
+/// where the field is 16 bits) in a file of a few hundred bytes: refused with the file's
+/// name and the numbers it claims, before any buffer for the voxels is made.
+#[test]
+fn headers_claiming_a_trillion_voxels_are_refused_before_any_buffer() {
+    let dir = scratch("trillion");
+    let fuel_nii = gunzip(&std::fs::read(data("ct/fuel.nii.gz")).unwrap());
+    let mut nii = fuel_nii[..352].to_vec();
+    for (i, d) in [10000i16, 10000, 10000].iter().enumerate() {
+        nii[42 + 2 * i..44 + 2 * i].copy_from_slice(&d.to_le_bytes());
+    }
+    nii.extend_from_slice(&fuel_nii[352..1352]);
+    let mut nifti2 = vec![0u8; 544];
+    nifti2[0..4].copy_from_slice(&540i32.to_le_bytes());
+    nifti2[4..12].copy_from_slice(b"n+2\0\r\n\x1a\n");
+    nifti2[12..14].copy_from_slice(&2i16.to_le_bytes());
+    nifti2[14..16].copy_from_slice(&8i16.to_le_bytes());
+    for (i, d) in [3i64, 10000, 10000, 10000, 1, 1, 1, 1].iter().enumerate() {
+        nifti2[16 + 8 * i..24 + 8 * i].copy_from_slice(&d.to_le_bytes());
+    }
+    for i in 0..8 {
+        nifti2[104 + 8 * i..112 + 8 * i].copy_from_slice(&1.0f64.to_le_bytes());
+    }
+    nifti2[168..176].copy_from_slice(&544i64.to_le_bytes());
+    let mut bin_dat: Vec<u8> = [65535u16; 3].iter().flat_map(|d| d.to_le_bytes()).collect();
+    bin_dat.extend([0u8; 64]);
+    let vti = r#"<?xml version="1.0"?><VTKFile type="ImageData" version="1.0" byte_order="LittleEndian" header_type="UInt64"><ImageData WholeExtent="0 9999 0 9999 0 9999" Origin="0 0 0" Spacing="1 1 1"><Piece Extent="0 9999 0 9999 0 9999"><PointData Scalars="s"><DataArray type="UInt8" Name="s" format="ascii">1 2 3</DataArray></PointData></Piece></ImageData></VTKFile>"#;
+    std::fs::write(dir.join("small.raw"), [7u8; 100]).unwrap();
+    let files: Vec<(&str, Vec<u8>)> = vec![
+        ("huge.nii", nii.clone()),
+        ("huge.nii.gz", gzip(&nii)),
+        ("huge2.nii", nifti2),
+        ("huge.nrrd", b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 10000 10000 10000\nencoding: raw\n\n\x01\x02\x03".to_vec()),
+        ("huge_gz.nrrd", b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 10000 10000 10000\nencoding: gzip\n\n\x1f\x8b".to_vec()),
+        (
+            "huge.mha",
+            b"ObjectType = Image\nNDims = 3\nDimSize = 10000 10000 10000\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n\x01".to_vec(),
+        ),
+        ("huge.vti", vti.as_bytes().to_vec()),
+        ("huge.dat", b"ObjectFileName: small.raw\nResolution: 10000 10000 10000\nSliceThickness: 1 1 1\nFormat: UCHAR\n".to_vec()),
+        ("huge_bin.dat", bin_dat),
+    ];
+    let mut cases: Vec<(std::path::PathBuf, ReadOptions, &str)> = Vec::new();
+    for (name, bytes) in &files {
+        std::fs::write(dir.join(name), bytes).unwrap();
+        let claim = if name.starts_with("huge_bin") { "65535" } else { "10000" };
+        cases.push((dir.join(name), ReadOptions::default(), claim));
+    }
+    // Headerless, with the dimensions given.
+    let raw = ReadOptions { raw: Some("10000x10000x10000:uint8".parse().unwrap()), ..Default::default() };
+    cases.push((dir.join("small.raw"), raw, "10000"));
+    // DICOM: the enhanced MR's 6 frames of 64² said to be 99 frames of 10 000² (its
+    // explicit-VR elements patched in place: Number of Frames, Rows, Columns).
+    let mut dcm = std::fs::read(data("dicom/enhanced_mr_multiframe.dcm")).unwrap();
+    for (tag, value) in
+        [([0x28u8, 0, 0x08, 0], *b"99"), ([0x28, 0, 0x10, 0], 10000u16.to_le_bytes()), ([0x28, 0, 0x11, 0], 10000u16.to_le_bytes())]
+    {
+        let at = dcm.windows(4).position(|w| w == tag).expect("the element is in the file") + 8;
+        dcm[at..at + 2].copy_from_slice(&value);
+    }
+    std::fs::write(dir.join("huge.dcm"), dcm).unwrap();
+    cases.push((dir.join("huge.dcm"), ReadOptions::default(), "10000"));
+    // OME-Zarr: every level's array said to be 10 000³.
+    let volume = read_volume(&data("ct/fuel.nii.gz"), &ReadOptions::default()).unwrap();
+    let store = dir.join("huge.zarr");
+    focal::volume::convert::ome_zarr::write(&volume, &store, &Default::default(), &|_, _| {}).unwrap();
+    for level in std::fs::read_dir(&store).unwrap().filter_map(|e| e.ok()).filter(|e| e.path().is_dir()) {
+        let meta = level.path().join("zarr.json");
+        let text = std::fs::read_to_string(&meta).unwrap();
+        let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        json["shape"] = serde_json::json!([10000, 10000, 10000]);
+        std::fs::write(&meta, json.to_string()).unwrap();
+    }
+    cases.push((store, ReadOptions::default(), "10000"));
+
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let mut failures = Vec::new();
+    for (path, options, claim) in &cases {
+        let name = path.file_name().unwrap().to_str().unwrap();
+        LARGEST.store(0, Ordering::Relaxed);
+        let result = read_volume(path, options);
+        let largest = LARGEST.load(Ordering::Relaxed);
+        match result {
+            Ok(v) => failures.push(format!("{name}: opened as {:?}", v.dims())),
+            Err(e) => {
+                let text = e.to_string();
+                if !text.contains(name) || !text.contains(claim) {
+                    failures.push(format!("{name}: the error does not name the file and {claim}: {text}"));
+                }
+            }
+        }
+        if largest > 1 << 20 {
+            failures.push(format!("{name}: {largest} bytes allocated at once before refusing"));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

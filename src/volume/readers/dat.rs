@@ -39,9 +39,23 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
         };
         return read_raw(path, &spec, options, "TU Wien .dat", vec![("layout".into(), "binary header: 3 × u16 dimensions".into())]);
     }
+    if d.iter().all(|&x| x > 0) && head.iter().any(|&b| b == 0 || b > 127) {
+        // Not text: a binary header whose voxels the file does not hold. The header's
+        // claim first (a trillion voxels is too large, not merely truncated).
+        options.check_size(d, 2).map_err(fail)?;
+        return Err(fail(Problem::Truncated(format!(
+            "the binary header gives {}×{}×{} 16-bit voxels ({} bytes after it), the file has {len} bytes",
+            d[0],
+            d[1],
+            d[2],
+            2 * d[0] * d[1] * d[2]
+        ))));
+    }
     let text = read_text(path, 1 << 16)?;
     let spec = parse_text(&text).map_err(fail)?;
     let (file, spec) = spec;
+    // The header's claim is checked against the limits here, so the error names it.
+    options.check_size([spec.dims.x as u64, spec.dims.y as u64, spec.dims.z as u64], spec.sample.size()).map_err(fail)?;
     let raw = path.parent().unwrap_or(Path::new(".")).join(file.trim());
     if !raw.is_file() {
         return Err(fail(Problem::Malformed(format!("ObjectFileName '{}' not found beside the .dat file", file.trim()))));
