@@ -18,6 +18,8 @@ mod edit;
 mod joints;
 #[path = "explode/paint.rs"]
 mod paint;
+#[path = "explode/stability.rs"]
+mod stability;
 
 fn app() -> App {
     let mut app = App::new();
