@@ -303,6 +303,9 @@ fn raw_and_volvis_dat() {
     .unwrap();
     let d = read_volume(&dir.join("fuel.dat"), &ReadOptions::default()).unwrap();
     assert_eq!(d.voxels, src.voxels);
+    // Saved with a byte-order mark (non-ASCII first bytes: not taken for a binary header).
+    std::fs::write(dir.join("bom.dat"), "\u{feff}ObjectFileName: fuel.raw\nResolution: 64 33 32\nFormat: UCHAR\n").unwrap();
+    assert_eq!(read_volume(&dir.join("bom.dat"), &ReadOptions::default()).unwrap().voxels, src.voxels);
     // TU Wien binary .dat: three u16 dims, then u16 voxels.
     let mut bin: Vec<u8> = [4u16, 2, 2].iter().flat_map(|d| d.to_le_bytes()).collect();
     bin.extend((0..16u16).flat_map(|v| (v * 100).to_le_bytes()));

@@ -39,21 +39,23 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
         };
         return read_raw(path, &spec, options, "TU Wien .dat", vec![("layout".into(), "binary header: 3 × u16 dimensions".into())]);
     }
-    if d.iter().all(|&x| x > 0) && head.iter().any(|&b| b == 0 || b > 127) {
-        // Not text: a binary header whose voxels the file does not hold. The header's
-        // claim first (a trillion voxels is too large, not merely truncated).
-        options.check_size(d, 2).map_err(fail)?;
-        return Err(fail(Problem::Truncated(format!(
-            "the binary header gives {}×{}×{} 16-bit voxels ({} bytes after it), the file has {len} bytes",
-            d[0],
-            d[1],
-            d[2],
-            2 * d[0] * d[1] * d[2]
-        ))));
-    }
-    let text = read_text(path, 1 << 16)?;
-    let spec = parse_text(&text).map_err(fail)?;
-    let (file, spec) = spec;
+    // The text convention first; where that fails on a file whose first bytes are not
+    // text, a binary header that does not match the file's length (its claim checked
+    // first: a trillion voxels is too large, not merely truncated).
+    let parsed = read_text(path, 1 << 16).and_then(|text| parse_text(&text).map_err(fail));
+    let (file, spec) = match parsed {
+        Ok(parsed) => parsed,
+        Err(_) if d.iter().all(|&x| x > 0) && head.iter().any(|&b| b == 0 || b > 127) => {
+            options.check_size(d, 2).map_err(fail)?;
+            let needed = 6 + 2 * d[0] * d[1] * d[2];
+            let text = format!(
+                "the binary header gives {}×{}×{} 16-bit voxels ({needed} bytes in all), the file has {len} bytes",
+                d[0], d[1], d[2]
+            );
+            return Err(fail(if len < needed { Problem::Truncated(text) } else { Problem::Malformed(text) }));
+        }
+        Err(e) => return Err(e),
+    };
     // The header's claim is checked against the limits here, so the error names it.
     options.check_size([spec.dims.x as u64, spec.dims.y as u64, spec.dims.z as u64], spec.sample.size()).map_err(fail)?;
     let raw = path.parent().unwrap_or(Path::new(".")).join(file.trim());
@@ -69,7 +71,8 @@ fn parse_text(text: &str) -> Result<(String, RawSpec), Problem> {
     let mut dims = None;
     let mut spacing = Vec3::ONE;
     let mut sample = None;
-    for line in text.lines() {
+    // (A byte-order mark, as some Windows editors save, is no part of the first key.)
+    for line in text.trim_start_matches('\u{feff}').lines() {
         let Some((k, v)) = line.split_once(':') else { continue };
         match k.trim().to_ascii_lowercase().as_str() {
             "objectfilename" => file = Some(v.trim().to_string()),

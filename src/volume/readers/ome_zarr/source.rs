@@ -87,7 +87,9 @@ impl ZarrSource {
             .filter_map(|l| {
                 let shape = l.array.chunk_shape(&vec![0; l.fixed.len()]).ok()?;
                 let elements = shape.iter().map(|c| c.get()).fold(1u64, u64::saturating_mul);
-                let prefix = format!("{}/", l.array.path().as_str().trim_matches('/'));
+                // (An array at the store's root: every key.)
+                let path = l.array.path().as_str().trim_matches('/');
+                let prefix = if path.is_empty() { String::new() } else { format!("{path}/") };
                 Some((prefix, elements.saturating_mul(8)))
             })
             .collect()
