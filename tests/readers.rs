@@ -189,6 +189,37 @@ fn dicom_series_sorted_along_the_normal() {
     assert_eq!(one.voxels, v.voxels);
 }
 
+/// A folder as users export them: the series's slices beside another series (the
+/// enhanced MR), a slice of the same series whose pixel data does not decode as the
+/// series's (Bits Allocated patched to 8), a file that is not DICOM and one that is
+/// truncated. Opening a slice reads its own series and names what it skipped.
+#[test]
+fn dicom_slice_in_a_mixed_folder_reads_its_own_series() {
+    let dir = scratch("dicom-mixed");
+    for n in ["1-001.dcm", "1-002.dcm", "1-003.dcm"] {
+        std::fs::copy(data(&format!("dicom/mr_3slices/{n}")), dir.join(n)).unwrap();
+    }
+    std::fs::copy(data("dicom/enhanced_mr_multiframe.dcm"), dir.join("0-enhanced.dcm")).unwrap();
+    let mut odd = std::fs::read(data("dicom/mr_3slices/1-003.dcm")).unwrap();
+    // (0028,0100) Bits Allocated, implicit VR: tag, 4-byte length, value 16 → 8.
+    let at = odd.windows(4).position(|w| w == [0x28, 0, 0, 1]).unwrap() + 8;
+    odd[at] = 8;
+    std::fs::write(dir.join("1-004.dcm"), &odd).unwrap();
+    std::fs::write(dir.join("notes.txt"), "exported by hand").unwrap();
+    let whole = std::fs::read(data("dicom/mr_3slices/1-002.dcm")).unwrap();
+    std::fs::write(dir.join("1-005.dcm"), &whole[..whole.len() / 2]).unwrap();
+    let v = read_volume(&dir.join("1-002.dcm"), &ReadOptions::default()).unwrap();
+    assert_eq!(v.dims().to_array(), [512, 512, 3]);
+    assert_eq!(v.voxels, read("dicom/mr_3slices").voxels);
+    let notes: Vec<&str> = v.source.details.iter().filter(|(k, _)| k == "note").map(|(_, n)| n.as_str()).collect();
+    let skipped = notes.iter().find(|n| n.contains("skipped")).unwrap_or_else(|| panic!("{notes:?}"));
+    assert!(skipped.contains("1-004.dcm") && skipped.contains("1-005.dcm") && skipped.starts_with("2 file(s)"), "{skipped}");
+    assert!(notes.iter().any(|n| n.contains("1 other series")), "{notes:?}");
+    // The opened file's own failure is the error, with its name.
+    let e = read_volume(&dir.join("1-004.dcm"), &ReadOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("1-004.dcm"), "{e}");
+}
+
 #[test]
 fn dicom_enhanced_multiframe() {
     let v = read("dicom/enhanced_mr_multiframe.dcm");

@@ -66,18 +66,25 @@ pub fn read_series(dir: &Path, files: &[PathBuf], options: &ReadOptions) -> Resu
     read_series_of(dir, files, None, options)
 }
 
-/// Like [`read_series`], restricted to one Series Instance UID when given.
+/// Like [`read_series`], restricted to one Series Instance UID when given. Where `at`
+/// is one of `files` (the user opened that slice), the group read is the one holding
+/// it, and its pixel format is the series's. Files of the group that cannot be read as
+/// that format (another format, pixel data that does not decode) are skipped and named
+/// in the volume's notes, as are files that do not parse; only the opened file's own
+/// failure is an error.
 pub fn read_series_of(at: &Path, files: &[PathBuf], uid: Option<&str>, options: &ReadOptions) -> Result<Volume, ReadError> {
     let mut objects: Vec<(PathBuf, DefaultDicomObject)> = Vec::new();
     let mut first_error: Option<ReadError> = None;
-    let mut skipped = 0usize;
+    let mut skipped: Vec<String> = Vec::new();
     for f in files {
         match open(f, options) {
             Ok(o) => objects.push((f.clone(), o)),
+            // The opened file's own failure is the answer.
+            Err(e) if f == at => return Err(e),
             Err(e) => {
                 // Non-DICOM files (DICOMDIR, notes) are common in exported folders.
                 if !matches!(e.problem, Problem::NotFormat { .. }) {
-                    skipped += 1;
+                    skipped.push(format!("{} ({})", file_name(f), e.problem));
                     first_error.get_or_insert(e);
                 }
             }
@@ -94,10 +101,15 @@ pub fn read_series_of(at: &Path, files: &[PathBuf], uid: Option<&str>, options: 
         (string(o, tags::SERIES_INSTANCE_UID), int(o, tags::ROWS), int(o, tags::COLUMNS), orient)
     };
     let mut groups: Vec<(_, Vec<usize>)> = Vec::new();
+    let mut other_series: Vec<Option<String>> = Vec::new();
     for (i, (_, o)) in objects.iter().enumerate() {
         if let Some(u) = uid
             && string(o, tags::SERIES_INSTANCE_UID).as_deref() != Some(u)
         {
+            let theirs = string(o, tags::SERIES_INSTANCE_UID);
+            if !other_series.contains(&theirs) {
+                other_series.push(theirs);
+            }
             continue;
         }
         let k = key(o);
@@ -106,39 +118,80 @@ pub fn read_series_of(at: &Path, files: &[PathBuf], uid: Option<&str>, options: 
             None => groups.push((k, vec![i])),
         }
     }
-    let Some((_, chosen)) = groups.iter().max_by_key(|(_, v)| v.len()) else {
+    let opened = objects.iter().position(|(p, _)| p == at);
+    let chosen = match opened {
+        Some(i) => groups.iter().find(|(_, v)| v.contains(&i)),
+        None => groups.iter().max_by_key(|(_, v)| v.len()),
+    };
+    let Some((_, chosen)) = chosen else {
         return Err(ReadError::new(at, Problem::Malformed("no slice of the series was readable".into())));
     };
-    let others = groups.len() - 1;
-    let (first_path, first) = &objects[chosen[0]];
-    let format = PixelFormat::of(first).map_err(|p| ReadError::new(first_path, p))?;
+    let others = groups.len() - 1 + other_series.len();
+    // The series's pixel format: the opened file's, else the most common one.
+    let formats: Vec<Result<PixelFormat, Problem>> = chosen.iter().map(|&i| PixelFormat::of(&objects[i].1)).collect();
+    let reference = match opened.filter(|o| chosen.contains(o)) {
+        Some(o) => PixelFormat::of(&objects[o].1).map_err(|p| ReadError::new(at, p))?,
+        None => {
+            let ok: Vec<PixelFormat> = formats.iter().filter_map(|f| f.as_ref().ok()).copied().collect();
+            match ok.iter().max_by_key(|f| ok.iter().filter(|g| g == f).count()) {
+                Some(common) => *common,
+                None => {
+                    let (p, o) = &objects[chosen[0]];
+                    return Err(ReadError::new(p, PixelFormat::of(o).err().unwrap_or(Problem::Malformed("no pixel format".into()))));
+                }
+            }
+        }
+    };
+    let format = reference;
     options
         .check_size([format.cols as u64, format.rows as u64, chosen.len() as u64], format.bits_allocated as usize / 8)
         .map_err(|p| ReadError::new(at, p))?;
     let mut planes = Vec::with_capacity(chosen.len());
-    for &i in chosen {
+    let mut first = None;
+    for (&i, f) in chosen.iter().zip(formats) {
         let (p, o) = &objects[i];
-        let f = PixelFormat::of(o).map_err(|e| ReadError::new(p, e))?;
-        if f != format {
-            return Err(ReadError::new(p, Problem::Malformed("pixel format differs from the rest of the series".into())));
+        let bytes = match f {
+            Ok(f) if f == format => pixel_bytes(o, &format, 1).map(|b| b.into_owned()),
+            Ok(_) => Err(Problem::Malformed("pixel format differs from the rest of the series".into())),
+            Err(e) => Err(e),
+        };
+        match bytes {
+            Ok(bytes) => {
+                first.get_or_insert(i);
+                planes.push(Plane {
+                    geometry: frame_geometry(o, None),
+                    instance: int(o, tags::INSTANCE_NUMBER).map(i64::from).unwrap_or(i as i64),
+                    bytes,
+                });
+            }
+            Err(e) if Some(i) == opened => return Err(ReadError::new(p, e)),
+            Err(e) => skipped.push(format!("{} ({e})", file_name(p))),
         }
-        let bytes = pixel_bytes(o, &format, 1).map_err(|e| ReadError::new(p, e))?.into_owned();
-        planes.push(Plane {
-            geometry: frame_geometry(o, None),
-            instance: int(o, tags::INSTANCE_NUMBER).map(i64::from).unwrap_or(i as i64),
-            bytes,
-        });
     }
+    let Some(first) = first else {
+        return Err(ReadError::new(at, Problem::Malformed(format!("no slice of the series was readable: {}", skipped.join("; ")))));
+    };
+    let first = &objects[first].1;
     let mut notes = Vec::new();
     if others > 0 {
         notes.push(format!("{others} other series (or image sizes) in the folder were not loaded"));
     }
-    if skipped > 0 {
-        notes.push(format!("{skipped} unreadable file(s) skipped"));
+    if !skipped.is_empty() {
+        const LISTED: usize = 5;
+        let more = skipped.len().saturating_sub(LISTED);
+        let mut listed = skipped[..skipped.len().min(LISTED)].join("; ");
+        if more > 0 {
+            listed.push_str(&format!("; and {more} more"));
+        }
+        notes.push(format!("{} file(s) skipped: {listed}", skipped.len()));
     }
     let name = string(first, tags::SERIES_DESCRIPTION)
         .unwrap_or_else(|| at.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "DICOM".into()));
     assemble(at, first, format, planes, name, "DICOM series", notes)
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| p.display().to_string())
 }
 
 /// Reads a multi-frame object.
