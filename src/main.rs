@@ -34,6 +34,10 @@ struct Args {
     /// Open the app with the slice views (axial, coronal, sagittal) under the 3D view.
     #[arg(long)]
     slices: bool,
+    /// Restore the view of the last session if it did not end cleanly (a crash, a kill),
+    /// without asking.
+    #[arg(long, conflicts_with = "volume")]
+    restore: bool,
 }
 
 #[derive(Subcommand)]
@@ -68,7 +72,7 @@ fn main() -> ExitCode {
                 eprintln!("error: window size '{}' is not WIDTHxHEIGHT", args.window);
                 return ExitCode::FAILURE;
             };
-            match focal::ui::run(args.volume.clone(), automation, window, args.slices) {
+            match focal::ui::run(args.volume.clone(), automation, window, (args.slices, args.restore)) {
                 bevy::app::AppExit::Success => Ok(()),
                 bevy::app::AppExit::Error(code) => Err(format!("the app stopped with code {code}")),
             }

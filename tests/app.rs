@@ -527,3 +527,74 @@ fn the_slices_of_a_streamed_pyramid_show_its_native_voxels() {
     assert!(pairs > 5000, "the slices show little: {pairs} grey pairs in {}", shot.display());
     assert!((equal as f64) < 0.45 * pairs as f64, "blocky slices: {equal} of {pairs} pairs equal in {}", shot.display());
 }
+
+/// A session killed with SIGKILL comes back: the app writes its view for recovery while
+/// it runs (and removes it when it exits cleanly); `focal --restore` opens it, and shows
+/// what the killed session showed.
+#[test]
+fn a_killed_session_is_restored() {
+    let dir = scratch("app-recovery");
+    let scene = dir.join("engine-lens.ron");
+    std::fs::write(
+        &scene,
+        r#"(datasets: [(source: Phantom(kind: engine, resolution: 64), appearance: (mode: dvr, preset: Some("industrial_ct")))],
+            camera: Orbit(azimuth_deg: 30.0, elevation_deg: 25.0, zoom: 0.85),
+            lenses: [(kind: magnifier(magnification: 2.5), center: (-0.2, -0.1), radius: 0.3, border: 0.12)])"#,
+    )
+    .unwrap();
+    // A clean run: its picture, and no recovery file left behind.
+    let shot = dir.join("before.png");
+    let before = app_screenshot(&scene, 4, &shot);
+    let config = config_dir(&shot);
+    let recovery = config.join("recovery.ron");
+    assert!(!recovery.exists(), "a clean exit leaves no recovery file");
+    // The same scene, killed once its view is saved.
+    let mut app = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_focal"))
+        .arg(&scene)
+        .args(["--window", "800x500"])
+        .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
+        .env("FOCAL_CONFIG_DIR", &config)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while !recovery.exists() && started.elapsed() < Duration::from_secs(300) {
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    assert!(recovery.exists(), "no recovery file within 300 s");
+    // (The app itself, not xvfb-run, whose command line also names it.)
+    let pattern = format!("^{} {}", env!("CARGO_BIN_EXE_focal"), scene.display());
+    let killed = Command::new("pkill").args(["-KILL", "-f", &pattern]).status().unwrap();
+    assert!(killed.success(), "no process matched {pattern}");
+    let _ = app.wait();
+    let saved = focal::scene::read_scene(&recovery).expect("the recovery file is a valid scene");
+    assert_eq!((saved.datasets.len(), saved.lenses.len()), (1, 1));
+    // Restored: the killed session's view, then a clean exit that leaves nothing.
+    let restored_shot = dir.join("restored.png");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_focal"))
+        .args(["--restore", "--window", "800x500", "--frames", "4", "--screenshot"])
+        .arg(&restored_shot)
+        .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
+        .env("FOCAL_CONFIG_DIR", &config)
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{log}");
+    assert!(log.contains("restored the last session's view"), "{log}");
+    assert!(!recovery.exists() && !config.join("recovery-previous.ron").exists());
+    let after = image::open(&restored_shot).unwrap().to_rgba8();
+    assert_eq!(after.dimensions(), before.dimensions());
+    let differing = before.pixels().zip(after.pixels()).filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 24)).count();
+    let share = differing as f64 / (before.width() * before.height()) as f64;
+    assert!(
+        share < 0.02,
+        "the restored view differs from the killed one in {:.1} % of the pixels ({})",
+        100.0 * share,
+        restored_shot.display()
+    );
+}

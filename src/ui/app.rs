@@ -31,6 +31,8 @@ pub struct FocalAppPlugin {
     pub screenshot_and_exit: Option<(u32, PathBuf)>,
     /// Open with the slice views shown.
     pub slices: bool,
+    /// Restore the last session's view if it did not end cleanly (`focal --restore`).
+    pub restore: bool,
 }
 
 impl Plugin for FocalAppPlugin {
@@ -49,16 +51,30 @@ impl Plugin for FocalAppPlugin {
             .init_resource::<super::movie::MovieRecorder>()
             .init_resource::<super::rulers::RulerTool>()
             .insert_resource(super::settings::Settings::load())
+            .insert_resource(super::recovery::Recovery::at_start(self.restore))
             .add_systems(
                 Startup,
-                move |mut commands: Commands, mut egui: ResMut<EguiGlobalSettings>, mut load: MessageWriter<LoadRequest>| {
+                move |mut commands: Commands,
+                      mut egui: ResMut<EguiGlobalSettings>,
+                      mut load: MessageWriter<LoadRequest>,
+                      mut recovery: ResMut<super::recovery::Recovery>| {
                     setup(&mut commands, &mut egui);
-                    load.write(match &initial {
+                    let restored = if recovery.restore_at_start {
+                        let r = recovery.restore();
+                        if r.is_none() {
+                            warn!("--restore: the last session left no view to restore");
+                        }
+                        r
+                    } else {
+                        None
+                    };
+                    load.write(restored.unwrap_or_else(|| match &initial {
                         Some(p) => LoadRequest::Path(p.clone()),
                         None => LoadRequest::Scene(Box::new(default_scene()), PathBuf::new()),
-                    });
+                    }));
                 },
             )
+            .add_systems(Last, super::recovery::remove_on_exit)
             .add_systems(
                 Update,
                 (
@@ -351,13 +367,18 @@ fn automation(
 }
 
 /// Runs the app.
-pub fn run(initial: Option<PathBuf>, screenshot_and_exit: Option<(u32, PathBuf)>, window: (u32, u32), slices: bool) -> AppExit {
+pub fn run(
+    initial: Option<PathBuf>,
+    screenshot_and_exit: Option<(u32, PathBuf)>,
+    window: (u32, u32),
+    (slices, restore): (bool, bool),
+) -> AppExit {
     App::new()
         .add_plugins(DefaultPlugins.set(WindowPlugin {
             primary_window: Some(Window { title: "Focal".into(), resolution: window.into(), ..default() }),
             ..default()
         }))
         .add_plugins((crate::FocalPlugins, crate::windows::frames::WindowFramePlugin))
-        .add_plugins(FocalAppPlugin { initial, screenshot_and_exit, slices })
+        .add_plugins(FocalAppPlugin { initial, screenshot_and_exit, slices, restore })
         .run()
 }

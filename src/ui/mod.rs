@@ -22,6 +22,7 @@ pub mod movie;
 pub mod objects_panel;
 pub mod orbit;
 pub mod panels;
+pub mod recovery;
 pub mod rulers;
 pub mod settings;
 pub mod slice_views;

@@ -77,6 +77,7 @@ type MoreParams<'w, 's> = (
     ResMut<'w, super::rulers::RulerTool>,
     Query<'w, 's, &'static crate::streaming::bricked::BrickedDataset>,
     Res<'w, super::under_cursor::UnderCursor>,
+    ResMut<'w, super::recovery::Recovery>,
 );
 
 /// Everything the panels read and edit.
@@ -99,7 +100,7 @@ pub fn ui(
     mut lens_params: lenses::LensParams,
     clip_gizmo: Res<super::clip_gizmo::ClipGizmo>,
     mut window_params: super::windows_panel::WindowParams,
-    (explode_specs, mut slice_views, rulers, mut movie, mut settings, mut ruler_tool, bricked, under_cursor): MoreParams,
+    (explode_specs, mut slice_views, rulers, mut movie, mut settings, mut ruler_tool, bricked, under_cursor, mut recovery): MoreParams,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(
@@ -371,15 +372,14 @@ pub fn ui(
 
     state.dialog.update(&ctx);
     let picked = state.dialog.take_picked().map(|p| (p, state.dialog_purpose));
-    // Writes the view as it is now as a scene file.
-    let save = |path: &std::path::Path| {
+    // The view as it is now, as a scene file's text.
+    let scene_now = || {
         // The saved datasets, in the order ds_states writes them.
         let mut saved: Vec<Entity> = datasets.iter().filter(|(_, _, _, o, _)| o.is_some()).map(|(e, ..)| e).collect();
         saved.sort();
         let windows = window_params.specs(&saved);
         let rulers: Vec<_> = rulers.iter().filter_map(|r| crate::slices::ruler::RulerSpec::of(r, &saved)).collect();
-        save_scene(
-            path,
+        scene_text(
             &ds_states(&datasets),
             ViewState {
                 camera: cams.single().map(|(o, ..)| o.camera()).ok(),
@@ -393,6 +393,18 @@ pub fn ui(
             &explode_specs,
         )
     };
+
+    // Writes the view as it is now as a scene file (`.ron` added when missing).
+    let save = |path: &std::path::Path| {
+        let path = if path.extension().is_some_and(|e| e == "ron") { path.to_path_buf() } else { path.with_extension("ron") };
+        std::fs::write(&path, scene_now()?).map_err(|e| format!("{}: {e}", path.display()))
+    };
+    // The view kept for recovery (nothing while a load is under way: the view is the
+    // old one, or none).
+    if loading.is_empty() && !ds_states(&datasets).is_empty() {
+        recovery.autosave(std::time::Instant::now(), scene_now);
+    }
+    super::recovery::offer(&ctx, &mut recovery, &mut load);
 
     // Movies.
     let animation = session.scene.as_ref().and_then(|s| s.animation.as_ref()).map(|a| (a.duration_s, a.fps));
@@ -619,15 +631,14 @@ struct ViewState<'a> {
     rendering: crate::scene::file::RenderingSpec,
 }
 
-/// Writes the app's state as a scene file at `path` (`.ron` added when missing).
-fn save_scene(
-    path: &std::path::Path,
+/// The app's state as a scene file's text.
+fn scene_text(
     rows: &[DatasetRow],
     view: ViewState,
     session: &Session,
     (windows, rulers): (crate::windows::spec::WindowScene, Vec<crate::slices::ruler::RulerSpec>),
     explode: &crate::explode::edit::CurrentSpecs,
-) -> Result<(), String> {
+) -> Result<String, String> {
     use crate::scene::save::{DatasetState, scene_file};
     let ViewState { camera, background, light, lenses, rendering } = view;
     let states: Vec<DatasetState> = rows
@@ -653,6 +664,5 @@ fn save_scene(
     // The loaded scene's animation, while it still fits what the view has (its lenses
     // and datasets).
     scene.animation = session.scene.as_ref().and_then(|s| s.animation.clone()).filter(|a| a.validate(&scene.animation_refers()).is_ok());
-    let path = if path.extension().is_some_and(|e| e == "ron") { path.to_path_buf() } else { path.with_extension("ron") };
-    std::fs::write(&path, scene.to_ron()?).map_err(|e| format!("{}: {e}", path.display()))
+    scene.to_ron()
 }

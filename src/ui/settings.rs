@@ -55,14 +55,8 @@ impl Settings {
 
     /// Writes the settings to `path` (to a temporary file beside it, then renamed).
     pub fn write(&self, path: &Path) -> Result<(), String> {
-        let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-        if let Some(dir) = path.parent() {
-            std::fs::create_dir_all(dir).map_err(|e| fail(&e))?;
-        }
-        let text = ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default()).map_err(|e| fail(&e))?;
-        let temporary = path.with_extension("ron.new");
-        std::fs::write(&temporary, text).map_err(|e| fail(&e))?;
-        std::fs::rename(&temporary, path).map_err(|e| fail(&e))
+        let text = ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default()).map_err(|e| format!("{}: {e}", path.display()))?;
+        write_atomically(path, &text)
     }
 
     /// Puts `path` first among the recent files (once), keeping [`MAX_RECENT`].
@@ -90,6 +84,17 @@ impl Settings {
     fn load_quiet() -> Settings {
         Settings::path().map(|p| Settings::read(&p).0).unwrap_or_default()
     }
+}
+
+/// Writes `text` to `path` whole: to a temporary file beside it, then renamed.
+pub fn write_atomically(path: &Path, text: &str) -> Result<(), String> {
+    let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| fail(&e))?;
+    }
+    let temporary = path.with_extension("ron.new");
+    std::fs::write(&temporary, text).map_err(|e| fail(&e))?;
+    std::fs::rename(&temporary, path).map_err(|e| fail(&e))
 }
 
 /// Writes the settings whenever they differ from what is on disk (as read at the first

@@ -1,0 +1,232 @@
+//! Session recovery: nothing a user built is lost to a crash, a kill or a lost device.
+//!
+//! While the app runs, the view as a scene file (datasets with their transfer functions
+//! and positions, lenses, windows, exploded parts where they are, rulers, the camera) is
+//! written to `recovery.ron` beside the settings ([`super::settings::Settings::path`])
+//! every [`EVERY`] when it changed: whole to a temporary file, then renamed, so a kill
+//! in the middle leaves the last complete copy. A clean exit removes it. A start that
+//! finds one (the last session did not end cleanly) moves it aside to
+//! `recovery-previous.ron`, out of this session's way, and offers to restore it;
+//! `focal --restore` restores it at once.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use bevy::prelude::*;
+use bevy_egui::egui;
+
+use super::loading::LoadRequest;
+use crate::scene::SceneFile;
+
+/// How often the view is written when it changed.
+pub const EVERY: Duration = Duration::from_secs(3);
+
+/// What the last session left.
+pub struct Found {
+    /// Where it was moved at start.
+    pub path: PathBuf,
+    pub scene: SceneFile,
+    /// When it was written, as the user reads it ("4 min ago").
+    pub age: String,
+}
+
+/// The recovery file of this session, and the one the last session left.
+#[derive(Resource, Default)]
+pub struct Recovery {
+    /// `recovery.ron` (`None`: no folder for settings, nothing is written).
+    pub path: Option<PathBuf>,
+    /// What this session wrote last.
+    last: Option<String>,
+    next: Option<Instant>,
+    /// The last session's view, until the user restores or discards it.
+    pub found: Option<Found>,
+    /// Restore it at start without asking (`focal --restore`).
+    pub restore_at_start: bool,
+}
+
+impl Recovery {
+    /// The recovery file beside the settings file.
+    pub fn file() -> Option<PathBuf> {
+        super::settings::Settings::path().map(|p| p.with_file_name("recovery.ron"))
+    }
+
+    /// At start: this session's recovery file, and the last session's view if it left
+    /// one (moved aside; one that does not read is set aside as `.bad`, with a warning).
+    pub fn at_start(restore_at_start: bool) -> Recovery {
+        let path = Recovery::file();
+        let found = path.as_deref().and_then(take_previous);
+        Recovery { path, found, restore_at_start, ..Default::default() }
+    }
+
+    /// Writes `text` if it is time and it differs from what was written last.
+    pub fn autosave(&mut self, now: Instant, text: impl FnOnce() -> Result<String, String>) {
+        if self.next.is_some_and(|t| now < t) {
+            return;
+        }
+        self.next = Some(now + EVERY);
+        let Some(path) = self.path.clone() else { return };
+        let text = match text() {
+            Ok(t) => t,
+            Err(e) => {
+                warn!("session not saved for recovery: {e}");
+                return;
+            }
+        };
+        if self.last.as_ref() == Some(&text) {
+            return;
+        }
+        match super::settings::write_atomically(&path, &text) {
+            Ok(()) => self.last = Some(text),
+            Err(e) => warn!("session not saved for recovery: {e}"),
+        }
+    }
+
+    /// A clean exit: nothing to recover.
+    pub fn remove(&self) {
+        if let Some(p) = &self.path
+            && let Err(e) = std::fs::remove_file(p)
+            && e.kind() != std::io::ErrorKind::NotFound
+        {
+            warn!("{}: {e}", p.display());
+        }
+    }
+
+    /// The last session's view as a load request (and its file removed: it is this
+    /// session's now).
+    pub fn restore(&mut self) -> Option<LoadRequest> {
+        let found = self.found.take()?;
+        let _ = std::fs::remove_file(&found.path);
+        info!("restored the last session's view from {}", found.path.display());
+        let base = found.path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Some(LoadRequest::Scene(Box::new(found.scene), base))
+    }
+
+    /// The last session's view discarded.
+    pub fn discard(&mut self) {
+        if let Some(found) = self.found.take() {
+            let _ = std::fs::remove_file(&found.path);
+        }
+    }
+}
+
+/// Moves a recovery file left at `path` aside and reads it (or the one moved aside
+/// before, when the user closed that session without choosing).
+fn take_previous(path: &Path) -> Option<Found> {
+    let previous = path.with_file_name("recovery-previous.ron");
+    if path.is_file() {
+        if let Err(e) = std::fs::rename(path, &previous) {
+            warn!("{}: {e}", path.display());
+            return None;
+        }
+    } else if !previous.is_file() {
+        return None;
+    }
+    let age = std::fs::metadata(&previous)
+        .and_then(|m| m.modified())
+        .ok()
+        .and_then(|t| t.elapsed().ok())
+        .map(|d| match d.as_secs() {
+            s if s < 120 => format!("{s} s ago"),
+            s if s < 7200 => format!("{} min ago", s / 60),
+            s => format!("{} h ago", s / 3600),
+        })
+        .unwrap_or_else(|| "at an unknown time".into());
+    match crate::scene::read_scene(&previous) {
+        Ok(scene) => Some(Found { path: previous, scene, age }),
+        Err(e) => {
+            let bad = previous.with_extension("ron.bad");
+            let _ = std::fs::rename(&previous, &bad);
+            warn!("the last session's view does not read ({e}); kept as {}", bad.display());
+            None
+        }
+    }
+}
+
+/// The offer to restore the last session's view (a window until the user chooses).
+pub fn offer(ctx: &egui::Context, recovery: &mut Recovery, load: &mut MessageWriter<LoadRequest>) {
+    let Some(found) = &recovery.found else { return };
+    let datasets = found.scene.datasets.len();
+    let mut choice = None;
+    egui::Window::new("Restore the last session?")
+        .collapsible(false)
+        .resizable(false)
+        .anchor(egui::Align2::CENTER_CENTER, [0.0, 0.0])
+        .show(ctx, |ui| {
+        ui.label(format!(
+            "The last session did not end cleanly. Its view ({datasets} dataset(s), with their looks, lenses, windows, parts and rulers) was saved {}.",
+            found.age
+        ));
+        ui.horizontal(|ui| {
+            if ui.button("Restore").clicked() {
+                choice = Some(true);
+            }
+            if ui.button("Discard").clicked() {
+                choice = Some(false);
+            }
+        });
+    });
+    match choice {
+        Some(true) => {
+            if let Some(request) = recovery.restore() {
+                load.write(request);
+            }
+        }
+        Some(false) => recovery.discard(),
+        None => {}
+    }
+}
+
+/// Removes the recovery file when the app exits cleanly.
+pub fn remove_on_exit(mut exits: MessageReader<AppExit>, recovery: Res<Recovery>) {
+    if exits.read().next().is_some() {
+        recovery.remove();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_view_is_written_when_it_changed_and_not_more_often_than_every_few_seconds() {
+        let dir = std::env::temp_dir().join(format!("focal-recovery-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let path = dir.join("recovery.ron");
+        let mut r = Recovery { path: Some(path.clone()), ..Default::default() };
+        let t0 = Instant::now();
+        let mut asked = 0;
+        r.autosave(t0, || {
+            asked += 1;
+            Ok("(datasets: [])".into())
+        });
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "(datasets: [])");
+        // Within EVERY: not even asked for the text.
+        r.autosave(t0 + EVERY / 2, || {
+            asked += 1;
+            Ok("(changed)".into())
+        });
+        assert_eq!((asked, std::fs::read_to_string(&path).unwrap().as_str()), (1, "(datasets: [])"));
+        r.autosave(t0 + EVERY, || Ok("(changed)".into()));
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "(changed)");
+        assert!(!path.with_extension("ron.new").exists());
+        // The next start finds it, moves it aside and reads it; a clean exit removes it.
+        std::fs::write(&path, "(datasets: [(source: Phantom(kind: engine, resolution: 32))])").unwrap();
+        let found = take_previous(&path).unwrap();
+        assert_eq!(found.scene.datasets.len(), 1);
+        assert!(!path.exists() && found.path.exists());
+        let mut next = Recovery { path: Some(path.clone()), found: Some(found), ..Default::default() };
+        assert!(matches!(next.restore(), Some(LoadRequest::Scene(..))));
+        assert!(!dir.join("recovery-previous.ron").exists());
+        next.autosave(t0, || Ok("(x)".into()));
+        next.remove();
+        assert!(!path.exists());
+        // Closed without a choice: offered again at the next start.
+        std::fs::write(dir.join("recovery-previous.ron"), "(datasets: [])").unwrap();
+        assert!(take_previous(&path).is_some_and(|f| f.scene.datasets.is_empty()));
+        std::fs::remove_file(dir.join("recovery-previous.ron")).unwrap();
+        // One that does not read is set aside, not offered.
+        std::fs::write(&path, "(datasets: [(source: Nonsense)])").unwrap();
+        assert!(take_previous(&path).is_none());
+        assert!(dir.join("recovery-previous.ron.bad").exists());
+    }
+}
