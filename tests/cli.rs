@@ -296,3 +296,23 @@ fn a_turntable_becomes_an_mp4_through_ffmpeg_where_it_is_installed() {
         assert!(call.contains(expected), "{expected} missing from: {call}");
     }
 }
+
+/// NaN voxels are empty space: fuel with its zero voxels made NaN draws as fuel does
+/// (the CPU reference, whose tables are the GPU's).
+#[test]
+fn nan_voxels_draw_as_empty_space() {
+    let dir = scratch("cli-nan");
+    common::masked_fuel_nifti(&dir.join("masked.nii"));
+    let render = |input: &std::path::Path, png: &str| {
+        let out = focal().args(["render", "--cpu", "--size", "96x96", "--out"]).arg(dir.join(png)).arg(input).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        image::open(dir.join(png)).unwrap().to_rgb8()
+    };
+    let plain = render(&data("ct/fuel.nii.gz"), "fuel.png");
+    let masked = render(&dir.join("masked.nii"), "masked.png");
+    let drawn = plain.pixels().filter(|p| p.0.iter().any(|&c| c > 20)).count();
+    assert!(drawn > 300, "fuel shows: {drawn} pixels");
+    let differ = plain.pixels().zip(masked.pixels()).filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 8)).count();
+    // (Where NaN voxels border true ones, trilinear samples blend the no-data code in: a few edge pixels.)
+    assert!(differ * 100 < 3 * drawn, "{differ} of {drawn} pixels differ ({})", dir.display());
+}

@@ -408,13 +408,42 @@ fn unknown_files_are_named() {
     assert!(e.to_string().contains("notes.xyz") && e.to_string().contains("unknown file format"), "{e}");
     let e = read_volume(&dir.join("missing.nii"), &ReadOptions::default()).unwrap_err();
     assert!(matches!(e.problem, Problem::Io(_)), "{e}");
-    // A float volume with NaNs is refused, not rendered with holes.
-    let mut nan = b"ObjectType = Image\nNDims = 3\nDimSize = 2 1 1\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n".to_vec();
-    nan.extend(1.0f32.to_le_bytes());
-    nan.extend(f32::NAN.to_le_bytes());
-    std::fs::write(dir.join("nan.mha"), nan).unwrap();
-    let e = read_volume(&dir.join("nan.mha"), &ReadOptions::default()).unwrap_err();
-    assert!(e.to_string().contains("NaN"), "{e}");
+    // A float volume with an infinite sample is refused (no place on the value axis).
+    let mut inf = b"ObjectType = Image\nNDims = 3\nDimSize = 2 1 1\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n".to_vec();
+    inf.extend(1.0f32.to_le_bytes());
+    inf.extend(f32::INFINITY.to_le_bytes());
+    std::fs::write(dir.join("inf.mha"), inf).unwrap();
+    let e = read_volume(&dir.join("inf.mha"), &ReadOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("infinite") && e.to_string().contains("inf.mha"), "{e}");
+}
+
+/// A masked float NIfTI, as resampling and masking tools write them: fuel's zero voxels
+/// made NaN. It opens, NaN as no data: counted in a note, left out of the statistics and
+/// the histogram, every true value as before.
+#[test]
+fn a_float_nifti_with_nan_voxels_opens_with_them_as_empty_space() {
+    let src = read("ct/fuel.nii.gz");
+    let dir = scratch("nan");
+    common::masked_fuel_nifti(&dir.join("masked.nii"));
+    let reals: Vec<f64> = (0..src.voxels.len()).map(|i| src.values.to_real(src.voxels.code(i) as f64)).collect();
+    let nan = reals.iter().filter(|&&v| v == 0.0).count();
+    let v = read_volume(&dir.join("masked.nii"), &ReadOptions::default()).unwrap();
+    assert!(nan > 1000, "fuel has background: {nan}");
+    assert_eq!(v.stats.no_data, nan as u64);
+    let note = v.source.details.iter().find(|(k, n)| k == "note" && n.contains("NaN")).map(|(_, n)| n.clone());
+    assert!(note.as_deref().is_some_and(|n| n.starts_with(&format!("{nan} of {}", reals.len()))), "{note:?}");
+    assert_eq!(v.stats.histogram.total(), (reals.len() - nan) as u64);
+    let finite: Vec<f64> = reals.iter().copied().filter(|&v| v != 0.0).collect();
+    assert_eq!(v.stats.min, finite.iter().copied().fold(f64::INFINITY, f64::min));
+    assert_eq!(v.stats.max, src.stats.max);
+    for (i, &r) in reals.iter().enumerate().step_by(97) {
+        let got = v.values.to_real(v.voxels.code(i) as f64);
+        if r == 0.0 {
+            assert_eq!(v.voxels.code(i), 0, "voxel {i} is no data");
+        } else {
+            assert!((got - r).abs() < 1e-9, "voxel {i}: {got} for {r}");
+        }
+    }
 }
 
 #[test]

@@ -54,6 +54,20 @@ impl Lut {
             let a = volume.values.to_real(-0.5);
             let b = volume.values.to_real(255.5);
             Lut::bake(&tf, a.min(b), a.max(b), LUT_SIZE_8)
+        } else if let Some(code) = volume.values.no_data {
+            // No data below every value (volume::encode::NO_DATA_GAP codes below the
+            // first): the table starts at it, and its texels below the first true value
+            // are transparent.
+            let empty = volume.values.to_real(code as f64);
+            let pad = (hi - empty).abs().max(1e-9) * 0.5 / LUT_SIZE_16 as f64;
+            let mut lut = Lut::bake(&tf, empty - pad, hi + pad, LUT_SIZE_16);
+            let (a, w) = (lut.lo, (lut.hi - lut.lo) / LUT_SIZE_16 as f64);
+            for (i, t) in lut.rgba.iter_mut().enumerate() {
+                if a + (i as f64 + 0.5) * w < lo {
+                    t[3] = 0.0;
+                }
+            }
+            lut
         } else {
             let pad = (hi - lo).abs().max(1e-9) * 0.5 / LUT_SIZE_16 as f64;
             Lut::bake(&tf, lo - pad, hi + pad, LUT_SIZE_16)
@@ -156,6 +170,28 @@ mod tests {
         // … and clamps outside them.
         assert_eq!(lut.sample(0.0)[3], 0.125);
         assert_eq!(lut.sample(1.0)[3], 0.875);
+    }
+
+    #[test]
+    fn no_data_is_transparent_and_true_values_keep_their_colour() {
+        use crate::volume::encode::{ByteOrder, SampleType, encode_samples};
+        use crate::volume::{Grid, Source, Volume};
+        // Values 0 … 100 with NaN between them, under an opaque table.
+        let values: Vec<f32> = (0..64).map(|i| if i % 5 == 0 { f32::NAN } else { i as f32 * 100.0 / 63.0 }).collect();
+        let bytes = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let e = encode_samples(bytes, SampleType::F32, ByteOrder::Little).unwrap();
+        let grid = Grid::new(glam::UVec3::new(4, 4, 4), glam::Vec3::ONE);
+        let v = Volume::new("nan", grid, e.voxels, e.map, Source::default()).unwrap();
+        assert_eq!((v.stats.no_data, v.stats.min as f32, v.stats.max), (13, 100.0 / 63.0, 100.0));
+        let mut opaque = ramp();
+        opaque.opacity = vec![OpacityPoint(0.0, 1.0), OpacityPoint(100.0, 1.0)];
+        let lut = Lut::for_volume(&opaque, &v);
+        let at = |code: f64| lut.sample(lut.texcoord(v.values.to_real(code)));
+        assert_eq!(at(0.0)[3], 0.0, "no data");
+        // The lowest true value: half a texel from the transparent ones; above it, opaque.
+        assert!(at(v.stats.code_min as f64)[3] >= 0.5);
+        assert!(at(v.stats.code_min as f64 + 16.0)[3] > 0.99);
+        assert!((at(v.stats.code_max as f64)[0] - 1.0).abs() < 1e-3);
     }
 
     #[test]

@@ -402,11 +402,10 @@ fn probe(slice: &Slice, dataset: &Dataset, px: glam::Vec2, level: Option<usize>)
     let v = slice.axes.voxel(slice.grid.dims, slice.index, x as u32, y as u32);
     let code = slice.codes[(y as u32 * slice.width + x as u32) as usize];
     let value = slice.values.to_real(code as f64);
-    let units = slice.values.units.as_deref().map(|u| format!(" {u}")).unwrap_or_default();
     let of_level = level.filter(|l| *l > 0).map(|l| format!(" of level {l}")).unwrap_or_default();
     Some(match &dataset.labels {
         Some(table) => format!("voxel ({}, {}, {}){of_level}: label {} {}", v.x, v.y, v.z, value, table.name(value as u32)),
-        None => format!("voxel ({}, {}, {}){of_level}: {value}{units}", v.x, v.y, v.z),
+        None => format!("voxel ({}, {}, {}){of_level}: {}", v.x, v.y, v.z, slice.values.describe(code as u32)),
     })
 }
 

@@ -90,14 +90,15 @@ pub fn describe(regions: &SceneRegions, hit: &Hit, dataset: &Dataset) -> Option<
     let volume = &dataset.volume;
     let q = volume.grid.world_to_index().transform_point3(point);
     let voxel = q.round().max(Vec3::ZERO).min(volume.dims().as_vec3() - 1.0).as_uvec3();
-    let value = volume.values.to_real(volume.code(voxel.x, voxel.y, voxel.z) as f64);
-    let units = volume.values.units.as_deref().map(|u| format!(" {u}")).unwrap_or_default();
+    let code = volume.code(voxel.x, voxel.y, voxel.z);
+    let value = volume.values.to_real(code as f64);
+    let shown = volume.values.describe(code as u32);
     // A label volume's label is its value; a segmented one's, its segmentation's there.
     let label = match &dataset.labels {
         Some(table) => Some(format!(", label {} {}", value, table.name(value.round().max(0.0) as u32))),
         None => crate::reference::label_at(&regions.scene, hit).map(|id| format!(", label {id}")),
     };
-    Some(format!("{} · voxel ({}, {}, {}): {value}{units}{}", volume.name, voxel.x, voxel.y, voxel.z, label.unwrap_or_default()))
+    Some(format!("{} · voxel ({}, {}, {}): {shown}{}", volume.name, voxel.x, voxel.y, voxel.z, label.unwrap_or_default()))
 }
 
 /// The probe's text at the top left of the 3D view (`free`): a slice's voxel while the

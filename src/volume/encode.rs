@@ -8,10 +8,17 @@
 //! - Floating-point samples that are all whole numbers within such a range are stored the
 //!   same lossless way (float label maps stay exact); other floats are quantised to
 //!   16-bit codes over their true `[min, max]`, which the map keeps.
-//! - NaN or infinite samples are an error: a silent hole in the picture is worse than a
-//!   clear refusal.
+//! - NaN samples (masked or resampled float images) are no value: code 0
+//!   ([`ValueMap::no_data`]), drawn as empty space and left out of the statistics; the
+//!   true values then start [`NO_DATA_GAP`] codes higher, so that the lookup table can
+//!   make the no-data texels transparent without touching a true value's. Infinite
+//!   samples are an error (no place on the value axis can show them).
 
 use super::voxels::{ValueMap, Voxels};
+
+/// Codes between the no-data code 0 and the first true value: two texels of a 16-bit
+/// volume's lookup table (`transfer::lut::LUT_SIZE_16` texels over 65 536 codes).
+pub const NO_DATA_GAP: u16 = 32;
 
 /// Sample types found in volume files.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -142,34 +149,48 @@ fn encode_with(n: usize, ty: SampleType, read: impl Fn(usize) -> f64) -> Result<
         return Err("no samples".into());
     }
     let (mut lo, mut hi, mut whole) = (f64::INFINITY, f64::NEG_INFINITY, true);
-    let mut bad = 0usize;
+    let (mut nan, mut infinite) = (0usize, 0usize);
     for i in 0..n {
         let v = read(i);
-        if !v.is_finite() {
-            bad += 1;
+        if v.is_nan() {
+            nan += 1;
+            continue;
+        }
+        if v.is_infinite() {
+            infinite += 1;
             continue;
         }
         lo = lo.min(v);
         hi = hi.max(v);
         whole &= v.fract() == 0.0;
     }
-    if bad > 0 {
-        return Err(format!("{bad} of {n} {} samples are NaN or infinite", ty.name()));
+    if infinite > 0 {
+        return Err(format!("{infinite} of {n} {} samples are infinite", ty.name()));
+    }
+    if nan == n {
+        return Err(format!("all {n} {} samples are NaN", ty.name()));
     }
     let range = hi - lo;
-    let exact = whole && range <= u16::MAX as f64;
+    // Codes 0 … gap − 1 stay free where NaN samples are (no data at code 0).
+    let gap = if nan > 0 { NO_DATA_GAP } else { 0 };
+    let no_data = (nan > 0).then_some(0u16);
+    let top = (u16::MAX - gap) as f64;
+    let exact = whole && range <= top;
     if exact && ty == SampleType::I8 {
         let codes = (0..n).map(|i| (read(i) - lo) as u8).collect();
         return Ok(Encoded { voxels: Voxels::U8(codes), map: ValueMap::new(1.0, lo) });
     }
+    let code = |v: f64, to_code: &dyn Fn(f64) -> f64| if v.is_nan() { 0 } else { gap + to_code(v - lo).clamp(0.0, top) as u16 };
     if exact {
-        let codes = (0..n).map(|i| (read(i) - lo) as u16).collect();
-        return Ok(Encoded { voxels: Voxels::U16(codes), map: ValueMap::new(1.0, lo) });
+        let codes = (0..n).map(|i| code(read(i), &|d| d)).collect();
+        let map = ValueMap { no_data, ..ValueMap::new(1.0, lo - gap as f64) };
+        return Ok(Encoded { voxels: Voxels::U16(codes), map });
     }
     // Quantise to 16 bits over the true range.
-    let slope = range / u16::MAX as f64;
-    let codes = (0..n).map(|i| ((read(i) - lo) / slope).round().clamp(0.0, u16::MAX as f64) as u16).collect();
-    Ok(Encoded { voxels: Voxels::U16(codes), map: ValueMap::new(slope, lo) })
+    let slope = if range > 0.0 { range / top } else { 1.0 };
+    let codes = (0..n).map(|i| code(read(i), &|d| (d / slope).round())).collect();
+    let map = ValueMap { no_data, ..ValueMap::new(slope, lo - gap as f64 * slope) };
+    Ok(Encoded { voxels: Voxels::U16(codes), map })
 }
 
 #[cfg(test)]
@@ -217,10 +238,30 @@ mod tests {
     }
 
     #[test]
+    fn nan_is_no_data_below_every_value() {
+        let raw: Vec<u8> = [-1.5f32, f32::NAN, 0.25, 2.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let e = encode_samples(raw, SampleType::F32, ByteOrder::Little).unwrap();
+        assert_eq!(e.map.no_data, Some(0));
+        assert_eq!([0, 1, 3].map(|i| e.voxels.code(i)), [NO_DATA_GAP, 0, 65535]);
+        assert_eq!((real(&e, 0), real(&e, 3)), (-1.5, 2.0));
+        assert!((real(&e, 2) - 0.25).abs() < 3.5 / 65503.0);
+        assert!(real(&e, 1) < -1.5);
+        assert_eq!((e.map.describe(0).as_str(), e.map.describe(65535).as_str()), ("no data (NaN)", "2"));
+        // Whole numbers stay exact, shifted past the gap.
+        let raw: Vec<u8> = [f64::NAN, 3.0, 7.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let e = encode_samples(raw, SampleType::F64, ByteOrder::Little).unwrap();
+        assert_eq!(e.voxels, Voxels::U16(vec![0, NO_DATA_GAP, NO_DATA_GAP + 4]));
+        assert_eq!((real(&e, 1), real(&e, 2)), (3.0, 7.0));
+    }
+
+    #[test]
     fn non_finite_and_ragged_input_are_errors() {
-        let raw: Vec<u8> = [1.0f32, f32::NAN].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let raw: Vec<u8> = [1.0f32, f32::INFINITY].iter().flat_map(|v| v.to_le_bytes()).collect();
         let err = encode_samples(raw, SampleType::F32, ByteOrder::Little).unwrap_err();
-        assert!(err.contains("NaN"), "{err}");
+        assert!(err.contains("infinite"), "{err}");
+        let raw: Vec<u8> = [f32::NAN, f32::NAN].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let err = encode_samples(raw, SampleType::F32, ByteOrder::Little).unwrap_err();
+        assert!(err.contains("all 2") && err.contains("NaN"), "{err}");
         assert!(encode_samples(vec![1, 2, 3], SampleType::I16, ByteOrder::Little).is_err());
         assert!(encode_samples(vec![], SampleType::I32, ByteOrder::Little).is_err());
     }

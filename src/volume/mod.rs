@@ -99,6 +99,17 @@ impl Volume {
             return Err(format!("value rescale {}·v + {} is not usable", values.slope, values.intercept));
         }
         let stats = stats::compute(&voxels, &values);
+        let mut source = source;
+        if stats.no_data > 0 {
+            source.details.push((
+                "note".into(),
+                format!(
+                    "{} of {} voxels are NaN: shown as empty space, left out of the statistics and the histogram",
+                    stats.no_data,
+                    voxels.len()
+                ),
+            ));
+        }
         Ok(Volume {
             name: name.into(),
             grid,

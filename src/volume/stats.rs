@@ -27,6 +27,8 @@ pub struct ValueStats {
     pub p99: f64,
     /// Number of voxels whose code is not the minimum (useful for masks and labels).
     pub above_min: u64,
+    /// Voxels with no value (`ValueMap::no_data`), left out of everything above.
+    pub no_data: u64,
     pub histogram: Histogram,
 }
 
@@ -83,8 +85,9 @@ pub fn code_counts(voxels: &Voxels) -> Vec<u64> {
 
 /// Computes the statistics of `voxels` under `map`.
 pub fn compute(voxels: &Voxels, map: &ValueMap) -> ValueStats {
-    let counts = code_counts(voxels);
-    from_counts(&counts, map)
+    let mut counts = code_counts(voxels);
+    let no_data = map.no_data.and_then(|c| counts.get_mut(c as usize)).map_or(0, std::mem::take);
+    ValueStats { no_data, ..from_counts(&counts, map) }
 }
 
 /// Derives the statistics from per-code counts (at least one count must be non-zero),
@@ -129,6 +132,7 @@ pub fn from_counts(counts: &[u64], map: &ValueMap) -> ValueStats {
         median: percentiles[1],
         p99: percentiles[2],
         above_min: total - counts.get(code_min).copied().unwrap_or(0),
+        no_data: 0,
         histogram: Histogram { min, max, counts: bins },
     }
 }

@@ -77,6 +77,11 @@ pub struct ValueMap {
     pub intercept: f64,
     /// Unit of the real value, e.g. `"HU"`; `None` when the file does not say.
     pub units: Option<String>,
+    /// The code that stands for no value (NaN samples of a float file, drawn as empty
+    /// space and left out of the statistics: `encode`, `stats`, `Lut::for_volume`). Its
+    /// real value lies below every true value.
+    #[serde(default)]
+    pub no_data: Option<u16>,
 }
 
 impl Default for ValueMap {
@@ -86,10 +91,19 @@ impl Default for ValueMap {
 }
 
 impl ValueMap {
-    pub const IDENTITY: ValueMap = ValueMap { slope: 1.0, intercept: 0.0, units: None };
+    pub const IDENTITY: ValueMap = ValueMap { slope: 1.0, intercept: 0.0, units: None, no_data: None };
 
     pub fn new(slope: f64, intercept: f64) -> Self {
-        Self { slope, intercept, units: None }
+        Self { slope, intercept, units: None, no_data: None }
+    }
+
+    /// A value as the probes write it: the real value and its unit, or no data.
+    pub fn describe(&self, code: u32) -> String {
+        if self.no_data.is_some_and(|c| c as u32 == code) {
+            return "no data (NaN)".into();
+        }
+        let units = self.units.as_deref().map(|u| format!(" {u}")).unwrap_or_default();
+        format!("{}{units}", self.to_real(code as f64))
     }
 
     #[inline]
@@ -106,7 +120,12 @@ impl ValueMap {
     /// Applies a further rescale `real' = real · slope + intercept` (e.g. a file's rescale
     /// on top of the storage offset).
     pub fn then(&self, slope: f64, intercept: f64) -> ValueMap {
-        ValueMap { slope: self.slope * slope, intercept: self.intercept * slope + intercept, units: self.units.clone() }
+        ValueMap {
+            slope: self.slope * slope,
+            intercept: self.intercept * slope + intercept,
+            units: self.units.clone(),
+            no_data: self.no_data,
+        }
     }
 
     pub fn with_units(mut self, units: Option<String>) -> Self {

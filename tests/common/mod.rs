@@ -20,3 +20,23 @@ pub fn scratch(name: &str) -> PathBuf {
     std::fs::create_dir_all(&d).expect("scratch directory");
     d
 }
+
+/// Writes fuel (`ct/fuel.nii.gz`) to `path` as a float32 NIfTI whose zero voxels are NaN,
+/// as masking and resampling tools write them.
+pub fn masked_fuel_nifti(path: &Path) {
+    let mut nii = Vec::new();
+    std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(std::fs::File::open(data("ct/fuel.nii.gz")).unwrap()), &mut nii).unwrap();
+    let offset = f32::from_le_bytes(nii[108..112].try_into().unwrap()) as usize;
+    let (slope, inter) = (f32::from_le_bytes(nii[112..116].try_into().unwrap()), f32::from_le_bytes(nii[116..120].try_into().unwrap()));
+    let slope = if slope == 0.0 { 1.0 } else { slope };
+    let mut out = nii[..offset].to_vec();
+    out[70..72].copy_from_slice(&16i16.to_le_bytes()); // datatype float32
+    out[72..74].copy_from_slice(&32i16.to_le_bytes()); // bitpix
+    out[112..116].copy_from_slice(&1.0f32.to_le_bytes()); // scl_slope
+    out[116..120].copy_from_slice(&0.0f32.to_le_bytes()); // scl_inter
+    for &c in &nii[offset..] {
+        let v = c as f32 * slope + inter;
+        out.extend((if v == 0.0 { f32::NAN } else { v }).to_le_bytes());
+    }
+    std::fs::write(path, out).unwrap();
+}
