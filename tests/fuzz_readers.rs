@@ -185,30 +185,49 @@ fn run_case(path: &Path, reader: Reader, what: &str) -> Result<(), String> {
     }
 }
 
-/// Writes each mutation of `bytes` to `dir/name` (`name` may name a file inside a
-/// folder that `dir` is, as an OME-Zarr store's metadata is) and reads it with
-/// `reader`, restoring the original afterwards. A failing input is kept beside the
-/// scratch folder under `failed-…` for `tests/fuzz_regressions`.
+/// Writes each mutation of `bytes` to `dir/name` and reads it with `reader`, restoring
+/// the original afterwards. A failing input is kept beside the scratch folder under
+/// `failed-…` for `tests/fuzz_regressions`.
 fn fuzz_bytes(label: &str, dir: &Path, name: &str, bytes: &[u8], reader: Reader, seed: u64, count: usize) -> Vec<String> {
+    let cases = mutations(bytes, seed, count);
+    fuzz_cases(
+        label,
+        (&dir.join(name), &dir.join(name)),
+        bytes,
+        reader,
+        cases,
+        &dir.with_file_name(format!("failed-{}", name.replace('/', "_"))),
+    )
+}
+
+/// Writes each of `cases` over `target` and reads `read` (the file itself, or the
+/// OME-Zarr store `target` belongs to); `keep` names the copies of failing inputs.
+fn fuzz_cases(
+    label: &str,
+    (target, read): (&Path, &Path),
+    bytes: &[u8],
+    reader: Reader,
+    cases: Vec<(String, Vec<u8>)>,
+    keep: &Path,
+) -> Vec<String> {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let p = dir.join(name);
     let mut failures = Vec::new();
-    for (k, (what, b)) in mutations(bytes, seed, count).into_iter().enumerate() {
-        std::fs::write(&p, &b).unwrap();
+    for (k, (what, b)) in cases.into_iter().enumerate() {
+        std::fs::write(target, &b).unwrap();
         LARGEST.store(0, Ordering::Relaxed);
-        let mut failed = run_case(&p, reader, &format!("{label}: {what}")).err();
+        let mut failed = run_case(read, reader, &format!("{label}: {what}")).err();
         let largest = LARGEST.load(Ordering::Relaxed);
         if largest > MAX_ALLOCATION {
             failed = Some(format!("{label}: {what}: allocated {largest} bytes at once"));
         }
         TRIED.fetch_add(1, Ordering::Relaxed);
         if let Some(e) = failed {
-            let keep = dir.with_file_name(format!("failed-{k}-{}", name.replace('/', "_")));
-            let _ = std::fs::write(&keep, &b);
-            failures.push(format!("{e} (kept as {})", keep.display()));
+            let kept = keep.with_file_name(format!("{}-{k}", keep.file_name().unwrap().to_string_lossy()));
+            let _ = std::fs::write(&kept, &b);
+            failures.push(format!("{e} (kept as {})", kept.display()));
         }
     }
-    std::fs::write(&p, bytes).unwrap();
+    std::fs::write(target, bytes).unwrap();
     failures
 }
 
@@ -387,27 +406,9 @@ fn ome_zarr_metadata_and_chunks() {
 
 /// Fuzzes one file of the store in `dir` (read through the store's folder).
 fn fuzz_store(label: &str, dir: &Path, rel: &str, bytes: &[u8], seed: u64) -> Vec<String> {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let target = dir.join(rel);
-    let store = dir.join("fuel.zarr");
-    let mut failures = Vec::new();
-    for (k, (what, b)) in mutations(bytes, seed, 12).into_iter().enumerate().take(60) {
-        std::fs::write(&target, &b).unwrap();
-        LARGEST.store(0, Ordering::Relaxed);
-        let mut failed = run_case(&store, Reader::Volume, &format!("{label}: {what}")).err();
-        let largest = LARGEST.load(Ordering::Relaxed);
-        if largest > MAX_ALLOCATION {
-            failed = Some(format!("{label}: {what}: allocated {largest} bytes at once"));
-        }
-        TRIED.fetch_add(1, Ordering::Relaxed);
-        if let Some(e) = failed {
-            let keep = dir.join(format!("failed-{k}-{}", rel.replace('/', "_")));
-            let _ = std::fs::write(&keep, &b);
-            failures.push(format!("{e} (kept as {})", keep.display()));
-        }
-    }
-    std::fs::write(&target, bytes).unwrap();
-    failures
+    let cases = mutations(bytes, seed, 12).into_iter().take(60).collect();
+    let keep = dir.join(format!("failed-{}", rel.replace('/', "_")));
+    fuzz_cases(label, (&dir.join(rel), &dir.join("fuel.zarr")), bytes, Reader::Volume, cases, &keep)
 }
 
 /// Inputs that once failed, each read again as the fuzzer read it: a volume, or a
