@@ -589,12 +589,16 @@ fn a_killed_session_is_restored() {
     assert!(!recovery.exists() && !config.join("recovery-previous.ron").exists());
     let after = image::open(&restored_shot).unwrap().to_rgba8();
     assert_eq!(after.dimensions(), before.dimensions());
-    let differing = before.pixels().zip(after.pixels()).filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 24)).count();
-    let share = differing as f64 / (before.width() * before.height()) as f64;
+    // (The same view; its jittered frames accumulate over a number of frames that depends
+    // on the machine's load, so shading differs by a few levels.)
+    let n = (before.width() * before.height()) as f64;
+    let mean =
+        before.pixels().zip(after.pixels()).map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c]) as f64).sum::<f64>() / 3.0).sum::<f64>() / n;
+    let drawn = |img: &image::RgbaImage| count_in(img, img.width() * 2 / 5, 30, &|p| p.0[..3].iter().any(|&c| c > 20)) as f64;
+    let (was, is) = (drawn(&before), drawn(&after));
     assert!(
-        share < 0.02,
-        "the restored view differs from the killed one in {:.1} % of the pixels ({})",
-        100.0 * share,
+        mean < 8.0 && (is - was).abs() < 0.03 * was,
+        "the restored view differs from the killed one: mean {mean:.1} levels, {is} drawn pixels for {was} ({})",
         restored_shot.display()
     );
 }

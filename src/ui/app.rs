@@ -342,13 +342,21 @@ fn automation(
     loading: Query<(), With<loading::Loading>>,
     progress: Option<Res<crate::render::RenderProgress>>,
     (stream, slices): (Option<Res<crate::streaming::bricked::StreamStatus>>, Res<super::slice_views::SliceViews>),
-    mut streaming_since: Local<Option<std::time::Instant>>,
+    (mut streaming_since, mut drawn_before): (Local<Option<std::time::Instant>>, Local<u64>),
 ) {
     let Some((after, path)) = state.screenshot_and_exit.clone() else { return };
-    let settled = progress.is_some_and(|p| p.volumes_drawn() > 0 && p.pipelines_settled());
+    let settled = progress.as_ref().is_some_and(|p| p.volumes_drawn() > 0 && p.pipelines_settled());
     if !loading.is_empty() || !settled {
         return;
     }
+    // Only frames the ray caster drew count: a pipeline asked for after the others had
+    // settled (a scene's lenses arrive a frame after its volumes) leaves frames undrawn
+    // while it compiles.
+    let drawn = progress.as_ref().map_or(0, |p| p.volumes_drawn());
+    if drawn == *drawn_before {
+        return;
+    }
+    *drawn_before = drawn;
     if state.frames == 0 && (!stream.is_none_or(|s| s.converged()) || slices.reading()) {
         let since = *streaming_since.get_or_insert_with(std::time::Instant::now);
         if since.elapsed() < crate::render::headless::STREAM_WAIT {
