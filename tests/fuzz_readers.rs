@@ -309,6 +309,13 @@ fn vti() {
 fn dicom() {
     fuzz("dicom/mr_3slices/1-001.dcm", 7, 60);
     fuzz("dicom/enhanced_mr_multiframe.dcm", 8, 60);
+    // pydicom's RT Dose grids: big-endian 32-bit, and RLE-coded (Focal's own RLE decoder
+    // for 32-bit samples).
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pydicom");
+    for (k, name) in ["rtdose_expb", "rtdose_rle"].iter().enumerate() {
+        let bytes = std::fs::read(fixtures.join(name).join(format!("{name}.dcm"))).unwrap();
+        fuzz_file(name, &bytes, &format!("{name}.dcm"), Reader::Volume, 40 + k as u64, 60);
+    }
 }
 
 #[test]

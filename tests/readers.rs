@@ -464,3 +464,43 @@ fn metaimage_uncompressed_with_a_data_file() {
     assert_eq!(v.voxels, src.voxels);
     assert_eq!(v.grid, src.grid);
 }
+
+/// A file of pydicom's public test data (`tests/fixtures/pydicom`, one a folder).
+fn pydicom(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pydicom").join(name).join(format!("{name}.dcm"))
+}
+
+/// An RT Dose grid of 15 frames (Grid Frame Offset Vector 0, 5, … 70 mm; Dose Grid
+/// Scaling 1e-6), as written (implicit VR), big-endian and RLE-coded with 32-bit
+/// samples: every frame, at its offset, in dose units. Values read by pydicom 3.0.1.
+#[test]
+fn rt_dose_grids_read_every_frame_at_its_offset_in_dose_units() {
+    for name in ["rtdose", "rtdose_expb", "rtdose_rle"] {
+        let v = read_volume(&pydicom(name), &ReadOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(v.dims().to_array(), [10, 10, 15], "{name}");
+        assert!((v.grid.spacing - Vec3::new(10.0, 10.0, 5.0)).length() < 1e-4, "{name}: {:?}", v.grid.spacing);
+        // pydicom: pixel_array[frame, row, column] × 1e-6; 32-bit values spanning 459 000
+        // steps are quantised to 16-bit codes (volume::encode): within half a code.
+        let half_code = 0.5 * (1.254 - 0.795) / 65535.0 + 1e-9;
+        for ((x, y, z), dose) in [((0, 0, 0), 1.249), ((1, 2, 3), 1.139), ((6, 4, 7), 1.026), ((9, 9, 14), 0.799)] {
+            assert!((v.real(x, y, z) - dose).abs() <= half_code, "{name} ({x}, {y}, {z}): {} for {dose}", v.real(x, y, z));
+        }
+        assert!((v.stats.min - 0.795).abs() < 1e-9 && (v.stats.max - 1.254).abs() < 1e-9, "{name}: {:?}", v.stats);
+        assert_eq!(v.values.units.as_deref(), Some("relative"), "{name}");
+    }
+}
+
+/// One MR image in several transfer syntaxes: RLE decodes to the same voxels; JPEG-LS
+/// and JPEG 2000, which Focal's decoders lack, are refused naming the file and the
+/// transfer syntax. Values read by pydicom 3.0.1.
+#[test]
+fn transfer_syntaxes_decode_alike_or_are_named() {
+    let plain = read_volume(&pydicom("MR_small"), &ReadOptions::default()).unwrap();
+    assert_eq!((plain.real(10, 20, 0), plain.real(0, 63, 0), plain.stats.min, plain.stats.max), (228.0, 378.0, 127.0, 2145.0));
+    let rle = read_volume(&pydicom("MR_small_RLE"), &ReadOptions::default()).unwrap();
+    assert_eq!(rle.voxels, plain.voxels);
+    for (name, uid) in [("MR_small_jpeg_ls_lossless", "1.2.840.10008.1.2.4.80"), ("MR_small_jp2klossless", "1.2.840.10008.1.2.4.90")] {
+        let e = read_volume(&pydicom(name), &ReadOptions::default()).unwrap_err().to_string();
+        assert!(e.contains(&format!("{name}.dcm")) && e.contains(uid), "{e}");
+    }
+}

@@ -5,6 +5,10 @@ use std::borrow::Cow;
 use std::path::Path;
 
 use dicom_dictionary_std::tags;
+use dicom_dictionary_std::uids::RLE_LOSSLESS;
+
+/// Explicit VR Big Endian (retired from the standard, still found in archives).
+const EXPLICIT_VR_BIG_ENDIAN: &str = "1.2.840.10008.1.2.2";
 use dicom_object::file::ReadPreamble;
 use dicom_object::mem::InMemElement;
 use dicom_object::{DefaultDicomObject, InMemDicomObject, OpenFileOptions, Tag};
@@ -34,20 +38,50 @@ pub fn open(path: &Path, options: &ReadOptions) -> Result<DefaultDicomObject, Re
 
 // --- attribute access -------------------------------------------------------
 
+/// Whether an element's value representation is UN (unknown): some converters write
+/// text attributes so (GDCM's RLE files); their bytes are the text, as pydicom reads
+/// them by the dictionary.
+fn unknown(e: &InMemElement) -> bool {
+    e.vr().to_string() == "UN"
+}
+
+/// The text of an attribute written with VR UN.
+fn unknown_text(e: &InMemElement) -> Option<String> {
+    unknown(e).then(|| e.to_bytes().ok().map(|b| String::from_utf8_lossy(&b).into_owned())).flatten()
+}
+
 pub(super) fn string(o: &InMemDicomObject, t: Tag) -> Option<String> {
-    o.get(t)?.to_str().ok().map(|s| s.trim().trim_end_matches('\0').to_string()).filter(|s| !s.is_empty())
+    let e = o.get(t)?;
+    let text = match unknown_text(e) {
+        Some(text) => text,
+        None => e.to_str().ok()?.into_owned(),
+    };
+    Some(text.trim().trim_end_matches('\0').trim().to_string()).filter(|s| !s.is_empty())
 }
 
 pub(super) fn floats(o: &InMemDicomObject, t: Tag) -> Option<Vec<f64>> {
-    o.get(t)?.to_multi_float64().ok().filter(|v| v.iter().all(|x| x.is_finite()))
+    let e = o.get(t)?;
+    let values = match unknown_text(e) {
+        Some(text) => text.trim_end_matches('\0').split('\\').map(|v| v.trim().parse::<f64>()).collect::<Result<Vec<_>, _>>().ok()?,
+        None => e.to_multi_float64().ok()?,
+    };
+    Some(values).filter(|v| v.iter().all(|x| x.is_finite()))
 }
 
 pub(super) fn float(o: &InMemDicomObject, t: Tag) -> Option<f64> {
+    if o.get(t).is_some_and(unknown) {
+        return floats(o, t).and_then(|v| v.first().copied());
+    }
     o.get(t)?.to_float64().ok().filter(|x| x.is_finite())
 }
 
 pub(super) fn int(o: &InMemDicomObject, t: Tag) -> Option<u32> {
-    o.get(t)?.to_int::<u32>().ok()
+    let e = o.get(t)?;
+    match unknown_text(e) {
+        // (Integer strings; binary integers written as UN stay unread.)
+        Some(text) => text.trim_end_matches('\0').trim().parse().ok(),
+        None => e.to_int::<u32>().ok(),
+    }
 }
 
 fn first_item(o: &InMemDicomObject, seq: Tag) -> Option<&InMemDicomObject> {
@@ -146,7 +180,29 @@ pub(super) fn pixel_bytes<'a>(object: &'a DefaultDicomObject, format: &PixelForm
     let need = format.frame_bytes() * frames;
     let element = object.element(tags::PIXEL_DATA).map_err(|_| Problem::Malformed("no Pixel Data".into()))?;
     let bytes = match element.to_bytes() {
+        // Explicit VR big endian: 32-bit samples in an OW element come as 16-bit words,
+        // each in native order, the sample's high word first: swap the words.
+        Ok(b)
+            if format.bits_allocated == 32
+                && element.vr().to_string() == "OW"
+                && object.meta().transfer_syntax().trim_end_matches('\0') == EXPLICIT_VR_BIG_ENDIAN =>
+        {
+            Cow::Owned(b.chunks_exact(4).flat_map(|w| [w[2], w[3], w[0], w[1]]).collect())
+        }
         Ok(b) => b,
+        Err(_) if format.bits_allocated == 32 && object.meta().transfer_syntax().trim_end_matches('\0') == RLE_LOSSLESS => {
+            // (dicom-pixeldata's RLE takes 8 and 16 bits; RT Dose grids are 32.)
+            let fragments = element.fragments().ok_or_else(|| Problem::Malformed("RLE pixel data without fragments".into()))?;
+            if fragments.len() < frames {
+                return Err(Problem::Truncated(format!("{} RLE fragment(s) for {frames} frame(s)", fragments.len())));
+            }
+            let samples = format.rows as usize * format.cols as usize;
+            let mut all = Vec::with_capacity(need);
+            for (k, f) in fragments[..frames].iter().enumerate() {
+                all.extend(super::rle::decode_frame(f, samples, 4).map_err(|e| Problem::Corrupt(format!("frame {k}: {e}")))?);
+            }
+            Cow::Owned(all)
+        }
         Err(_) => {
             // Encapsulated (compressed) pixel data: let dicom-pixeldata decode it.
             use dicom_pixeldata::PixelDecoder;

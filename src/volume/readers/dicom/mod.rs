@@ -19,6 +19,7 @@
 
 mod file;
 pub mod guard;
+mod rle;
 mod series;
 
 use std::path::{Path, PathBuf};

@@ -49,7 +49,8 @@ fn frame_geometry(o: &InMemDicomObject, frame: Option<usize>) -> FrameGeometry {
         }
         None => float(o, tag),
     };
-    let slope = rescale(tags::RESCALE_SLOPE).filter(|s| *s != 0.0).unwrap_or(1.0);
+    // (RT Dose: Dose Grid Scaling turns stored values into dose.)
+    let slope = rescale(tags::RESCALE_SLOPE).or_else(|| float(o, tags::DOSE_GRID_SCALING)).filter(|s| *s != 0.0).unwrap_or(1.0);
     let intercept = rescale(tags::RESCALE_INTERCEPT).unwrap_or(0.0);
     FrameGeometry { position, orientation, pixel_spacing, slope, intercept }
 }
@@ -73,6 +74,9 @@ pub fn read_series(dir: &Path, files: &[PathBuf], options: &ReadOptions) -> Resu
 /// in the volume's notes, as are files that do not parse; only the opened file's own
 /// failure is an error.
 pub fn read_series_of(at: &Path, files: &[PathBuf], uid: Option<&str>, options: &ReadOptions) -> Result<Volume, ReadError> {
+    // (The folder's listing may name the opened file otherwise: `./a.dcm` for `a.dcm`.)
+    let at_canonical = std::fs::canonicalize(at).ok();
+    let is_opened = |p: &Path| p == at || at_canonical.is_some() && std::fs::canonicalize(p).ok() == at_canonical;
     let mut objects: Vec<(PathBuf, DefaultDicomObject)> = Vec::new();
     let mut first_error: Option<ReadError> = None;
     let mut skipped: Vec<String> = Vec::new();
@@ -80,7 +84,7 @@ pub fn read_series_of(at: &Path, files: &[PathBuf], uid: Option<&str>, options: 
         match open(f, options) {
             Ok(o) => objects.push((f.clone(), o)),
             // The opened file's own failure is the answer.
-            Err(e) if f == at => return Err(e),
+            Err(e) if is_opened(f) => return Err(e),
             Err(e) => {
                 // Non-DICOM files (DICOMDIR, notes) are common in exported folders.
                 if !matches!(e.problem, Problem::NotFormat { .. }) {
@@ -118,7 +122,7 @@ pub fn read_series_of(at: &Path, files: &[PathBuf], uid: Option<&str>, options: 
             None => groups.push((k, vec![i])),
         }
     }
-    let opened = objects.iter().position(|(p, _)| p == at);
+    let opened = objects.iter().position(|(p, _)| is_opened(p));
     let chosen = match opened {
         Some(i) => groups.iter().find(|(_, v)| v.contains(&i)),
         None => groups.iter().max_by_key(|(_, v)| v.len()),
@@ -205,6 +209,16 @@ pub fn read_multiframe(path: &Path, object: DefaultDicomObject, options: &ReadOp
     let mut planes: Vec<Plane> = (0..frames)
         .map(|f| Plane { geometry: frame_geometry(&object, Some(f)), instance: f as i64, bytes: all[f * fb..(f + 1) * fb].to_vec() })
         .collect();
+    // RT Dose: the frames' offsets along the normal from the first (Grid Frame Offset
+    // Vector; relative when its first element is 0, else absolute: the differences from
+    // the first element serve both).
+    let offsets = floats(&object, tags::GRID_FRAME_OFFSET_VECTOR).filter(|o| o.len() == frames && o.iter().all(|x| x.is_finite()));
+    if let (Some(offsets), Some(p0), Some([r, c])) = (offsets, planes[0].geometry.position, planes[0].geometry.orientation) {
+        let n = r.cross(c).normalize();
+        for (p, o) in planes.iter_mut().zip(&offsets) {
+            p.geometry.position = Some(p0 + n * (o - offsets[0]) as f32);
+        }
+    }
     // Frames without their own position: stack them along the normal from the first.
     if planes.iter().any(|p| p.geometry.position.is_none())
         && let (Some(p0), Some([r, c])) = (
@@ -319,8 +333,12 @@ fn assemble(
         encode_values(&real, crate::volume::SampleType::F64).map_err(|e| fail(Problem::Values(e)))?
     };
     let modality = string(first, tags::MODALITY);
-    let units =
-        string(first, tags::RESCALE_TYPE).filter(|t| t != "US").or_else(|| (modality.as_deref() == Some("CT")).then(|| "HU".to_string()));
+    let units = string(first, tags::RESCALE_TYPE)
+        .filter(|t| t != "US")
+        .or_else(|| (modality.as_deref() == Some("CT")).then(|| "HU".to_string()))
+        .or_else(|| {
+            string(first, tags::DOSE_UNITS).map(|u| if u.eq_ignore_ascii_case("GY") { "Gy".into() } else { u.to_ascii_lowercase() })
+        });
     let values = ValueMap { units, ..encoded.map };
 
     let mut details: Vec<(String, String)> = Vec::new();
