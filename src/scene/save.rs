@@ -74,6 +74,11 @@ pub fn scene_file(
                         .as_ref()
                         .zip(d.spec.appearance.segmentation.as_ref())
                         .map(|(seg, spec)| segmentation_spec(seg, spec.labels)),
+                    // (A label table's path made absolute too, as the source's.)
+                    labels: AppearanceSpec::of(d.appearance, d.spec.appearance.labels.as_ref()).labels.map(|mut l| {
+                        l.table = l.table.map(|t| std::fs::canonicalize(resolve(base, &t)).unwrap_or_else(|_| resolve(base, &t)));
+                        l
+                    }),
                     ..AppearanceSpec::of(d.appearance, d.spec.appearance.labels.as_ref())
                 },
                 translation: d.translation.into(),

@@ -51,7 +51,7 @@ impl Plugin for FocalAppPlugin {
             .init_resource::<super::movie::MovieRecorder>()
             .init_resource::<super::rulers::RulerTool>()
             .insert_resource(super::settings::Settings::load())
-            .insert_resource(super::recovery::Recovery::at_start(self.restore))
+            .insert_resource(super::recovery::Recovery::at_start(self.restore, self.screenshot_and_exit.is_some()))
             .add_systems(
                 Startup,
                 move |mut commands: Commands,

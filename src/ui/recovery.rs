@@ -52,7 +52,11 @@ impl Recovery {
 
     /// At start: this session's recovery file, and the last session's view if it left
     /// one (moved aside; one that does not read is set aside as `.bad`, with a warning).
-    pub fn at_start(restore_at_start: bool) -> Recovery {
+    /// Test automation (`automation`) neither writes nor offers one, unless it restores.
+    pub fn at_start(restore_at_start: bool, automation: bool) -> Recovery {
+        if automation && !restore_at_start {
+            return Recovery::default();
+        }
         let path = Recovery::file();
         let found = path.as_deref().and_then(take_previous);
         Recovery { path, found, restore_at_start, ..Default::default() }
@@ -91,11 +95,15 @@ impl Recovery {
         }
     }
 
-    /// The last session's view as a load request (and its file removed: it is this
-    /// session's now).
+    /// The last session's view as a load request. Its file becomes this session's
+    /// recovery file (should the restored view crash again, the next start finds it).
     pub fn restore(&mut self) -> Option<LoadRequest> {
         let found = self.found.take()?;
-        let _ = std::fs::remove_file(&found.path);
+        if let Some(path) = &self.path
+            && let Err(e) = std::fs::rename(&found.path, path)
+        {
+            warn!("{}: {e}", found.path.display());
+        }
         info!("restored the last session's view from {}", found.path.display());
         let base = found.path.parent().map(Path::to_path_buf).unwrap_or_default();
         Some(LoadRequest::Scene(Box::new(found.scene), base))
@@ -216,7 +224,8 @@ mod tests {
         assert!(!path.exists() && found.path.exists());
         let mut next = Recovery { path: Some(path.clone()), found: Some(found), ..Default::default() };
         assert!(matches!(next.restore(), Some(LoadRequest::Scene(..))));
-        assert!(!dir.join("recovery-previous.ron").exists());
+        // Now this session's recovery file, until this session writes its own.
+        assert!(!dir.join("recovery-previous.ron").exists() && path.exists());
         next.autosave(t0, || Ok("(x)".into()));
         next.remove();
         assert!(!path.exists());

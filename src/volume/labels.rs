@@ -92,14 +92,16 @@ impl LabelVolume {
     pub fn from_volume(volume: Volume, table: LabelTable) -> Result<LabelVolume, String> {
         let counts = super::stats::code_counts(&volume.voxels);
         let mut max_id = 0u32;
-        for (code, _) in counts.iter().enumerate().filter(|(_, c)| **c > 0) {
+        // (No data, NaN in a float label map, is the background.)
+        let no_data = volume.values.no_data.map(usize::from);
+        for (code, _) in counts.iter().enumerate().filter(|(c, n)| **n > 0 && Some(*c) != no_data) {
             let real = volume.values.to_real(code as f64);
             if real.fract() != 0.0 || !(0.0..=65535.0).contains(&real) {
                 return Err(format!("value {real} is not a label id (whole number 0..65535)"));
             }
             max_id = max_id.max(real as u32);
         }
-        let id_of = |c: u16| volume.values.to_real(c as f64) as u32;
+        let id_of = |c: u16| if Some(c as usize) == no_data { 0 } else { volume.values.to_real(c as f64) as u32 };
         let voxels = match (&volume.voxels, max_id <= 255) {
             (Voxels::U8(v), true) if volume.values == ValueMap::IDENTITY => Voxels::U8(v.clone()),
             (v, true) => Voxels::U8((0..v.len()).map(|i| id_of(v.code(i)) as u8).collect()),
@@ -129,6 +131,18 @@ impl LabelVolume {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nan_in_a_float_label_map_is_background() {
+        use crate::volume::encode::{ByteOrder, SampleType, encode_samples};
+        let ids: Vec<f32> = vec![f32::NAN, 3.0, 17.0, f32::NAN, 0.0, 3.0, 17.0, 17.0];
+        let e = encode_samples(ids.iter().flat_map(|v| v.to_le_bytes()).collect(), SampleType::F32, ByteOrder::Little).unwrap();
+        let v =
+            Volume::new("labels", crate::volume::Grid::new(glam::UVec3::splat(2), glam::Vec3::ONE), e.voxels, e.map, Default::default())
+                .unwrap();
+        let l = LabelVolume::from_volume(v, LabelTable::default()).unwrap();
+        assert_eq!((0..8).map(|i| l.volume.voxels.code(i)).collect::<Vec<_>>(), vec![0, 3, 17, 0, 0, 3, 17, 17]);
+    }
     use crate::volume::Grid;
     use glam::{UVec3, Vec3};
 

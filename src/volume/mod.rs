@@ -186,7 +186,7 @@ impl Volume {
 
     /// Levels 1… of the mip chain (built on first use; see [`pyramid`]).
     pub fn pyramid(&self) -> &[pyramid::Level] {
-        self.pyramid.get_or_init(|| pyramid::build(&self.voxels, self.grid.dims))
+        self.pyramid.get_or_init(|| pyramid::build_skipping(&self.voxels, self.grid.dims, self.values.no_data))
     }
 
     /// Largest central-difference gradient magnitude in normalised units per voxel,

@@ -26,8 +26,22 @@ pub fn half_dims(dims: UVec3) -> UVec3 {
     (dims + 1) / 2
 }
 
+/// The mean of a block's codes, leaving out `no_data` (NaN voxels: `ValueMap::no_data`);
+/// a block of no data alone is no data. (Every true code lies above the no-data gap, so
+/// the mean of true codes does too.)
+pub fn block_mean(codes: &[u32], no_data: Option<u16>) -> u32 {
+    let skip = no_data.map(u32::from);
+    let (sum, n) = codes.iter().filter(|&&c| Some(c) != skip).fold((0u32, 0u32), |(s, n), &c| (s + c, n + 1));
+    (sum + n / 2).checked_div(n).unwrap_or(skip.unwrap_or(0))
+}
+
 /// The level above `voxels` (`dims`).
 pub fn halve(voxels: &Voxels, dims: UVec3) -> Level {
+    halve_skipping(voxels, dims, None)
+}
+
+/// [`halve`] with `no_data` left out of each block's mean ([`block_mean`]).
+pub fn halve_skipping(voxels: &Voxels, dims: UVec3, no_data: Option<u16>) -> Level {
     let out = half_dims(dims);
     let (nx, ny, nz) = (dims.x as usize, dims.y as usize, dims.z as usize);
     let mut codes = Vec::with_capacity((out.x * out.y * out.z) as usize);
@@ -37,14 +51,17 @@ pub fn halve(voxels: &Voxels, dims: UVec3) -> Level {
             let (y0, y1) = (2 * y, (2 * y + 1).min(ny - 1));
             for x in 0..out.x as usize {
                 let (x0, x1) = (2 * x, (2 * x + 1).min(nx - 1));
-                let mut sum = 0u32;
+                let mut block = [0u32; 8];
+                let mut k = 0;
                 for zz in [z0, z1] {
                     for yy in [y0, y1] {
                         let row = (zz * ny + yy) * nx;
-                        sum += voxels.code(row + x0) as u32 + voxels.code(row + x1) as u32;
+                        block[k] = voxels.code(row + x0) as u32;
+                        block[k + 1] = voxels.code(row + x1) as u32;
+                        k += 2;
                     }
                 }
-                codes.push(((sum + 4) / 8) as u16);
+                codes.push(block_mean(&block, no_data) as u16);
             }
         }
     }
@@ -57,13 +74,18 @@ pub fn halve(voxels: &Voxels, dims: UVec3) -> Level {
 
 /// Levels 1 to [`MIP_LEVELS`] of a volume (fewer when it shrinks to one voxel).
 pub fn build(voxels: &Voxels, dims: UVec3) -> Vec<Level> {
+    build_skipping(voxels, dims, None)
+}
+
+/// [`build`] with `no_data` left out of every mean.
+pub fn build_skipping(voxels: &Voxels, dims: UVec3, no_data: Option<u16>) -> Vec<Level> {
     let mut levels: Vec<Level> = Vec::with_capacity(MIP_LEVELS);
     for _ in 0..MIP_LEVELS {
         let (v, d) = levels.last().map_or((voxels, dims), |l| (&l.voxels, l.dims));
         if d == UVec3::ONE {
             break;
         }
-        levels.push(halve(v, d));
+        levels.push(halve_skipping(v, d, no_data));
     }
     levels
 }
@@ -77,6 +99,17 @@ pub fn level_index(q: Vec3, k: u32) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn no_data_is_left_out_of_block_means() {
+        // NaN voxels (code 0) beside true codes 40 000 and 40 002: the mean of the true
+        // ones, not a value between them and the no-data code.
+        assert_eq!(block_mean(&[0, 40000, 0, 40002], Some(0)), 40001);
+        assert_eq!(block_mean(&[0, 0], Some(0)), 0);
+        assert_eq!(block_mean(&[0, 40000, 0, 40002], None), 20001);
+        let v = Voxels::U16(vec![0, 40000, 0, 40002, 0, 0, 0, 0]);
+        assert_eq!(halve_skipping(&v, UVec3::splat(2), Some(0)).voxels, Voxels::U16(vec![40001]));
+    }
 
     #[test]
     fn levels_average_blocks_and_round_odd_sizes_up() {

@@ -31,16 +31,16 @@ pub fn downsample2(volume: &Volume, filter: Filter) -> Result<Volume, String> {
         if filter == Filter::Nearest {
             return code(x0, y0, z0) as u16;
         }
-        let (mut sum, mut n) = (0u32, 0u32);
+        let (mut block, mut n) = ([0u32; 8], 0);
         for zz in z0..(z0 + 2).min(d.z) {
             for yy in y0..(y0 + 2).min(d.y) {
                 for xx in x0..(x0 + 2).min(d.x) {
-                    sum += code(xx, yy, zz);
+                    block[n] = code(xx, yy, zz);
                     n += 1;
                 }
             }
         }
-        ((sum + n / 2) / n) as u16
+        super::pyramid::block_mean(&block[..n], volume.values.no_data) as u16
     };
     let count = nd.x as usize * nd.y as usize * nd.z as usize;
     let voxels = match volume.voxels {

@@ -24,7 +24,7 @@ impl MemorySource {
         let mut above: Vec<pyramid::Level> = Vec::with_capacity(n - 1);
         for _ in 1..n {
             let (v, d) = above.last().map_or((&volume.voxels, volume.dims()), |l| (&l.voxels, l.dims));
-            let next = pyramid::halve(v, d);
+            let next = pyramid::halve_skipping(v, d, volume.values.no_data);
             above.push(next);
         }
         let levels = (0..n as u32).map(|k| SourceLevel { grid: level_grid(&volume.grid, k), chunk: UVec3::splat(64) }).collect();

@@ -213,7 +213,10 @@ pub fn read_multiframe(path: &Path, object: DefaultDicomObject, options: &ReadOp
     // Vector; relative when its first element is 0, else absolute: the differences from
     // the first element serve both).
     let offsets = floats(&object, tags::GRID_FRAME_OFFSET_VECTOR).filter(|o| o.len() == frames && o.iter().all(|x| x.is_finite()));
-    if let (Some(offsets), Some(p0), Some([r, c])) = (offsets, planes[0].geometry.position, planes[0].geometry.orientation) {
+    let one_position = planes.iter().all(|p| p.geometry.position == planes[0].geometry.position);
+    if let (Some(offsets), true, Some(p0), Some([r, c])) =
+        (offsets, one_position, planes[0].geometry.position, planes[0].geometry.orientation)
+    {
         let n = r.cross(c).normalize();
         for (p, o) in planes.iter_mut().zip(&offsets) {
             p.geometry.position = Some(p0 + n * (o - offsets[0]) as f32);
