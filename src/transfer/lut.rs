@@ -54,23 +54,20 @@ impl Lut {
             let a = volume.values.to_real(-0.5);
             let b = volume.values.to_real(255.5);
             Lut::bake(&tf, a.min(b), a.max(b), LUT_SIZE_8)
-        } else if let Some(code) = volume.values.no_data {
-            // No data below every value (volume::encode::NO_DATA_GAP codes below the
-            // first): the table starts at it, and its texels below the first true value
+        } else {
+            // With no data (volume::encode::NO_DATA_GAP codes below the first true
+            // value) the table starts at it, and its texels below the first true value
             // are transparent.
-            let empty = volume.values.to_real(code as f64);
-            let pad = (hi - empty).abs().max(1e-9) * 0.5 / LUT_SIZE_16 as f64;
-            let mut lut = Lut::bake(&tf, empty - pad, hi + pad, LUT_SIZE_16);
-            let (a, w) = (lut.lo, (lut.hi - lut.lo) / LUT_SIZE_16 as f64);
-            for (i, t) in lut.rgba.iter_mut().enumerate() {
-                if a + (i as f64 + 0.5) * w < lo {
+            let bottom = volume.values.no_data.map_or(lo, |code| volume.values.to_real(code as f64));
+            let pad = (hi - bottom).abs().max(1e-9) * 0.5 / LUT_SIZE_16 as f64;
+            let mut lut = Lut::bake(&tf, bottom - pad, hi + pad, LUT_SIZE_16);
+            if volume.values.no_data.is_some() {
+                let (a, w) = (lut.lo, (lut.hi - lut.lo) / LUT_SIZE_16 as f64);
+                for (_, t) in lut.rgba.iter_mut().enumerate().filter(|(i, _)| a + (*i as f64 + 0.5) * w < lo) {
                     t[3] = 0.0;
                 }
             }
             lut
-        } else {
-            let pad = (hi - lo).abs().max(1e-9) * 0.5 / LUT_SIZE_16 as f64;
-            Lut::bake(&tf, lo - pad, hi + pad, LUT_SIZE_16)
         }
     }
 

@@ -401,7 +401,7 @@ pub fn ui(
     };
     // The view kept for recovery (nothing while a load is under way: the view is the
     // old one, or none).
-    if loading.is_empty() && !ds_states(&datasets).is_empty() {
+    if loading.is_empty() && datasets.iter().any(|(_, _, _, o, _)| o.is_some()) {
         recovery.autosave(std::time::Instant::now(), scene_now);
     }
     super::recovery::offer(&ctx, &mut recovery, &mut load);

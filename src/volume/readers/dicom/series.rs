@@ -76,7 +76,8 @@ pub fn read_series(dir: &Path, files: &[PathBuf], options: &ReadOptions) -> Resu
 pub fn read_series_of(at: &Path, files: &[PathBuf], uid: Option<&str>, options: &ReadOptions) -> Result<Volume, ReadError> {
     // (The folder's listing may name the opened file otherwise: `./a.dcm` for `a.dcm`.)
     let at_canonical = std::fs::canonicalize(at).ok();
-    let is_opened = |p: &Path| p == at || at_canonical.is_some() && std::fs::canonicalize(p).ok() == at_canonical;
+    let is_opened =
+        |p: &Path| p == at || p.file_name() == at.file_name() && at_canonical.is_some() && std::fs::canonicalize(p).ok() == at_canonical;
     let mut objects: Vec<(PathBuf, DefaultDicomObject)> = Vec::new();
     let mut first_error: Option<ReadError> = None;
     let mut skipped: Vec<String> = Vec::new();
