@@ -310,12 +310,16 @@ fn dicom() {
     fuzz("dicom/mr_3slices/1-001.dcm", 7, 60);
     fuzz("dicom/enhanced_mr_multiframe.dcm", 8, 60);
     // pydicom's RT Dose grids: big-endian 32-bit, and RLE-coded (Focal's own RLE decoder
-    // for 32-bit samples).
+    // for 32-bit samples); its deflated data set (inflated by the guard, then the parser)
+    // and a JPEG 2000 image (openjp2).
     let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pydicom");
-    for (k, name) in ["rtdose_expb", "rtdose_rle"].iter().enumerate() {
+    for (k, name) in ["rtdose_expb", "rtdose_rle", "image_dfl", "JPEG2000"].iter().enumerate() {
         let bytes = std::fs::read(fixtures.join(name).join(format!("{name}.dcm"))).unwrap();
         fuzz_file(name, &bytes, &format!("{name}.dcm"), Reader::Volume, 40 + k as u64, 60);
     }
+    // A 1-bit segmentation (packed frames, per-frame segments and positions).
+    let seg = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/dicom_seg/seg_binary/seg_binary.dcm");
+    fuzz_file("seg_binary", &std::fs::read(seg).unwrap(), "seg_binary.dcm", Reader::Volume, 44, 80);
 }
 
 #[test]

@@ -490,17 +490,122 @@ fn rt_dose_grids_read_every_frame_at_its_offset_in_dose_units() {
     }
 }
 
-/// One MR image in several transfer syntaxes: RLE decodes to the same voxels; JPEG-LS
-/// and JPEG 2000, which Focal's decoders lack, are refused naming the file and the
-/// transfer syntax. Values read by pydicom 3.0.1.
+/// One MR image in several transfer syntaxes: RLE and lossless JPEG 2000 decode to the
+/// same voxels; JPEG-LS, which Focal's decoders lack (CharLS is C++), and 12-bit JPEG
+/// Extended are refused naming the file and the transfer syntax. Values read by pydicom
+/// 3.0.1.
 #[test]
 fn transfer_syntaxes_decode_alike_or_are_named() {
     let plain = read_volume(&pydicom("MR_small"), &ReadOptions::default()).unwrap();
     assert_eq!((plain.real(10, 20, 0), plain.real(0, 63, 0), plain.stats.min, plain.stats.max), (228.0, 378.0, 127.0, 2145.0));
-    let rle = read_volume(&pydicom("MR_small_RLE"), &ReadOptions::default()).unwrap();
-    assert_eq!(rle.voxels, plain.voxels);
-    for (name, uid) in [("MR_small_jpeg_ls_lossless", "1.2.840.10008.1.2.4.80"), ("MR_small_jp2klossless", "1.2.840.10008.1.2.4.90")] {
+    for name in ["MR_small_RLE", "MR_small_jp2klossless"] {
+        let coded = read_volume(&pydicom(name), &ReadOptions::default()).unwrap();
+        assert_eq!(coded.voxels, plain.voxels, "{name}");
+    }
+    for (name, uid) in [
+        ("MR_small_jpeg_ls_lossless", "1.2.840.10008.1.2.4.80"),
+        // (12-bit JPEG Extended: jpeg-decoder takes 8-bit samples; pydicom with Pillow
+        // refuses it too.)
+        ("JPEG-lossy", "1.2.840.10008.1.2.4.51 (JPEG Extended"),
+    ] {
         let e = read_volume(&pydicom(name), &ReadOptions::default()).unwrap_err().to_string();
         assert!(e.contains(&format!("{name}.dcm")) && e.contains(uid), "{e}");
     }
+    assert!(
+        read_volume(&pydicom("JPEG-lossy"), &ReadOptions::default()).unwrap_err().to_string().contains("SamplePrecision(12)"),
+        "the decoder's reason is named"
+    );
+}
+
+/// JPEG 2000 images, lossy and lossless (one whose code stream is unsigned where its
+/// header says signed), decode as pydicom 3.0.1 with Pillow's OpenJPEG reads them, in
+/// real values (Rescale Intercept −1024 for the CT): pixels (row, column) and sums.
+#[test]
+fn jpeg_2000_images_decode_as_pydicom_reads_them() {
+    for (name, pixels, sum) in [
+        ("JPEG2000", [((0, 0), 0.0), ((100, 200), -2.0), ((1023, 3), 0.0)], 3_527_976.0),
+        ("693_J2KI", [((0, 0), -3040.0), ((100, 200), -895.0), ((511, 3), -3040.0)], -270_617_240.0),
+        ("J2K_pixelrep_mismatch", [((0, 0), -2000.0), ((100, 200), -285.0), ((511, 3), -2000.0)], -172_605_258.0),
+    ] {
+        let v = read_volume(&pydicom(name), &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+        for ((row, col), value) in pixels {
+            assert_eq!(v.real(col, row, 0), value, "{name} ({row}, {col})");
+        }
+        let n = v.voxels.len() as f64;
+        assert!((v.stats.mean * n - sum).abs() < 1e-6 * sum.abs(), "{name}: sum {} for {sum}", v.stats.mean * n);
+    }
+}
+
+/// A data set in the deflated transfer syntax (the whole set after the meta group one
+/// deflate stream) reads as pydicom 3.0.1 reads it.
+#[test]
+fn a_deflated_data_set_reads_as_pydicom_reads_it() {
+    let v = read_volume(&pydicom("image_dfl"), &ReadOptions::default()).unwrap();
+    assert_eq!(v.dims().to_array(), [512, 512, 1]);
+    // pydicom: pixel_array[0, 0], [100, 200], [511, 3] (row, column); the sum 33 322 688.
+    assert_eq!((v.real(0, 0, 0), v.real(200, 100, 0), v.real(3, 511, 0)), (213.0, 41.0, 115.0));
+    assert!((v.stats.mean - 33_322_688.0 / (512.0 * 512.0)).abs() < 1e-9, "{}", v.stats.mean);
+}
+
+/// The segmentations written by `tests/fixtures/dicom_seg/make_segs.py` (pydicom packs
+/// the bits), with the label volumes numpy made beside them.
+fn segmentation(name: &str) -> (Volume, Vec<u8>) {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/dicom_seg");
+    let v = read_volume(&dir.join(format!("seg_{name}/seg_{name}.dcm")), &ReadOptions::default()).unwrap();
+    (v, std::fs::read(dir.join(format!("expected_{name}.u8"))).unwrap())
+}
+
+/// A 1-bit segmentation (19 × 13 pixels: frames share bytes) is a label volume: every
+/// frame on its slice of the 2.5 mm grid (slice 4, with no frame, background), the
+/// higher segment where two overlap, the segments' names and CIELab colours in its table.
+#[test]
+fn a_binary_segmentation_reads_as_a_label_volume() {
+    let (v, expected) = segmentation("binary");
+    assert_eq!(v.dims().to_array(), [19, 13, 6]);
+    let codes: Vec<u8> = (0..v.voxels.len()).map(|i| v.voxels.code(i) as u8).collect();
+    let ids: Vec<f64> = (0..v.voxels.len()).map(|i| v.values.to_real(v.voxels.code(i) as f64)).collect();
+    assert!(
+        ids.iter().zip(&expected).all(|(a, &b)| *a == b as f64),
+        "{} voxels differ",
+        ids.iter().zip(&expected).filter(|(a, b)| **a != **b as f64).count()
+    );
+    assert!(codes.iter().skip(4 * 19 * 13).take(19 * 13).all(|&c| c == 0), "the slice without a frame is background");
+    // Spacing (columns, rows, slices) and the oblique rows: LPS (0.8, 0.6, 0) is RAS (−0.8, −0.6, 0).
+    assert!((v.grid.spacing - Vec3::new(0.9, 0.7, 2.5)).length() < 1e-5, "{:?}", v.grid.spacing);
+    assert!((v.grid.direction.x_axis - Vec3::new(-0.8, -0.6, 0.0)).length() < 1e-5);
+    assert!((v.grid.origin - Vec3::new(10.0, -20.0, 30.0)).length() < 1e-4, "{:?}", v.grid.origin);
+    let table = v.label_table.as_ref().expect("the segments' table");
+    let names: Vec<_> = table.labels.iter().map(|(id, l)| (*id, l.name.as_str())).collect();
+    assert_eq!(names, vec![(1, "liver"), (2, "tumour"), (3, "vessel")]);
+    // (CIELab of sRGB red, green and blue.)
+    for (id, rgb) in [(1, [255, 0, 0]), (2, [0, 255, 0]), (3, [0, 0, 255])] {
+        assert!(table.color(id).iter().zip(rgb).all(|(a, b)| a.abs_diff(b) <= 2), "{id}: {:?}", table.color(id));
+    }
+    assert!(v.source.details.iter().any(|(_, n)| n.contains("24 voxel(s) in more than one segment")), "{:?}", v.source.details);
+}
+
+/// An 8-bit FRACTIONAL segmentation: a voxel is in its segment from half the Maximum
+/// Fractional Value (200) up.
+#[test]
+fn a_fractional_segmentation_is_thresholded_at_half_its_maximum() {
+    let (v, expected) = segmentation("fractional");
+    assert_eq!(v.dims().to_array(), [19, 13, 2]);
+    let ids: Vec<u8> = (0..v.voxels.len()).map(|i| v.values.to_real(v.voxels.code(i) as f64) as u8).collect();
+    assert_eq!(ids, expected);
+    assert_eq!(v.label_table.as_ref().and_then(|t| t.get(4)).map(|l| l.name.as_str()), Some("probable lesion"));
+}
+
+/// A scene (or the app, or `focal render`) opening a segmentation without saying
+/// `labels` shows it as labels, with the segments' names.
+#[test]
+fn a_segmentation_opens_as_labels_with_its_names() {
+    let scene = focal::scene::SceneFile::parse(
+        r#"(datasets: [(source: File("tests/fixtures/dicom_seg/seg_binary/seg_binary.dcm"))])"#,
+        "segmentation scene",
+    )
+    .unwrap();
+    let d = focal::scene::load::load_datasets(&scene, std::path::Path::new(env!("CARGO_MANIFEST_DIR"))).unwrap();
+    let table = d[0].table.as_ref().expect("shown as labels");
+    assert_eq!(table.name(2), "tumour");
+    assert!(d[0].spec.appearance.labels.is_some(), "saved as labels");
 }

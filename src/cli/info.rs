@@ -37,8 +37,12 @@ pub fn run(args: &InfoArgs) -> Result<(), String> {
         };
         match read {
             Ok(v) => {
-                let table = label_table::read_sidecars(f).map_err(|e| e.to_string())?;
-                let labels = (args.labels || !table.is_empty()).then(|| LabelVolume::from_volume(v.clone(), table)).transpose()?;
+                // (The sidecar table, else the one the file carries: a segmentation's.)
+                let sidecars = label_table::read_sidecars(f).map_err(|e| e.to_string())?;
+                let carried = v.label_table.clone();
+                let shown = args.labels || !sidecars.is_empty() || carried.is_some();
+                let table = if sidecars.is_empty() { carried.unwrap_or_default() } else { sidecars };
+                let labels = shown.then(|| LabelVolume::from_volume(v.clone(), table)).transpose()?;
                 reports.push(report(&v, labels.as_ref()));
             }
             Err(e) => failures.push(e),
@@ -61,6 +65,9 @@ fn procedural(size: &str) -> Result<Volume, String> {
     load_finest_within(&source, WHOLE_LEVEL_BYTES, &|_| {}).map_err(|e| e.to_string())
 }
 
+/// Most labels listed by name.
+const LISTED_LABELS: usize = 24;
+
 fn report(v: &Volume, labels: Option<&LabelVolume>) -> Value {
     let g = &v.grid;
     let s = &v.stats;
@@ -72,6 +79,7 @@ fn report(v: &Volume, labels: Option<&LabelVolume>) -> Value {
             "count": ids.iter().filter(|(id, _)| *id != 0).count(),
             "table_entries": l.table.len(),
             "largest": ids.iter().filter(|(id, _)| *id != 0).max_by_key(|(_, c)| *c).map(|(id, c)| json!({"id": id, "name": named(&l.table, *id), "voxels": c})),
+            "present": ids.iter().filter(|(id, _)| *id != 0).take(LISTED_LABELS).map(|(id, c)| json!({"id": id, "name": named(&l.table, *id), "voxels": c})).collect::<Vec<_>>(),
         })
     });
     json!({
@@ -140,6 +148,9 @@ fn print_text(r: &Value) {
     }
     if let Some(l) = r["labels"].as_object() {
         println!("  labels       {} present, {} in the table", f_num(&l["count"]), f_num(&l["table_entries"]));
+        for p in l["present"].as_array().into_iter().flatten() {
+            println!("    {:>5}  {} ({} voxels)", f_num(&p["id"]), p["name"].as_str().unwrap_or(""), f_num(&p["voxels"]));
+        }
     }
     if let Some(details) = r["details"].as_array() {
         for d in details {

@@ -42,10 +42,12 @@ pub struct VolumeView {
 }
 
 /// On a view whose picture at rest is averaged over frames of different ray jitter
-/// (`interactive` puts it there): this frame is the `index`-th of the average (0 starts
-/// it anew) and weighs `1 / (index + 1)` against what was gathered, so after `frames`
-/// frames the picture is their mean; from then on it is held (no rays are cast, the
-/// average is drawn). The view's [`VolumeView::frame`] seeds each frame's jitter.
+/// (`interactive` puts it there): this frame is the `index`-th at rest (0 starts the
+/// average anew). The renderer counts the frames it actually blended into the average
+/// (a frame it could not draw, its pipeline still compiling, is not one of them): the
+/// next weighs `1 / (blended + 1)` against them, so after `frames` of them the picture
+/// is their mean; from then on it is held (no rays are cast, the average is drawn).
+/// The view's [`VolumeView::frame`] seeds each frame's jitter.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Accumulate {
     pub index: u32,
@@ -53,14 +55,15 @@ pub struct Accumulate {
 }
 
 impl Accumulate {
-    /// The weight of this frame against the frames before it.
-    pub fn weight(&self) -> f32 {
-        1.0 / (self.index as f32 + 1.0)
+    /// The weight of a frame against the `blended` frames already in the average.
+    pub fn weight(blended: u32) -> f32 {
+        1.0 / (blended as f64 + 1.0) as f32
     }
 
-    /// Whether the average is complete: the frame casts no rays and shows it.
-    pub fn holds(&self) -> bool {
-        self.index >= self.frames
+    /// Whether the average of `blended` frames is complete: the frame casts no rays and
+    /// shows it.
+    pub fn holds(&self, blended: u32) -> bool {
+        blended >= self.frames
     }
 }
 

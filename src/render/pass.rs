@@ -88,7 +88,7 @@ pub fn raycast_pass(
     // An averaging view: this frame into the average with its weight (none once the
     // average is complete and held), then the average over the view.
     let averaged = upscaled.and(accumulation.and_then(|(a, id, frame)| Some((a, cache.get_render_pipeline(id.0)?, frame))));
-    let hold = averaged.is_some_and(|(.., frame)| frame.holds());
+    let hold = averaged.is_some_and(|(average, _, frame)| frame.holds(average.blended.get()));
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
     if !hold {
@@ -120,11 +120,12 @@ pub fn raycast_pass(
     }
     if let Some((reduced, upscale_pipeline)) = upscaled {
         let mut source = &reduced.texture.default_view;
-        if let Some((average, average_pipeline, frame)) = averaged {
+        if let Some((average, average_pipeline, _)) = averaged {
             if !hold {
-                let into =
-                    Drawn { source, target: &average.view, pipeline: average_pipeline, viewport: None, weight: Some(frame.weight()) };
+                let weight = Some(Accumulate::weight(average.blended.get()));
+                let into = Drawn { source, target: &average.view, pipeline: average_pipeline, viewport: None, weight };
                 draw_texture(&mut ctx, &upscale, &cache, into, "focal_accumulate");
+                average.blended.add_one();
             }
             source = &average.view;
         }

@@ -46,12 +46,37 @@ pub struct ReducedTarget {
     pub size: UVec2,
 }
 
-/// The average of an accumulating view's jittered frames, kept between frames.
+/// The average of an accumulating view's jittered frames, kept between frames, and how
+/// many frames were blended into it: only frames the pass drew count, so an average is
+/// never held before it has its frames (the main world's frame index runs on while a
+/// pipeline compiles).
 #[derive(Component)]
 pub struct AccumulationTarget {
     pub texture: Texture,
     pub view: TextureView,
     pub size: UVec2,
+    pub blended: BlendedFrames,
+}
+
+/// The count of frames blended into an average (set from the render pass, which reads
+/// its view's components only).
+#[derive(Default, Debug)]
+pub struct BlendedFrames(std::sync::atomic::AtomicU32);
+
+impl BlendedFrames {
+    pub fn get(&self) -> u32 {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// One more frame in the average.
+    pub fn add_one(&self) {
+        self.0.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// The average starts anew.
+    pub fn restart(&self) {
+        self.0.store(0, std::sync::atomic::Ordering::Relaxed);
+    }
 }
 
 /// The pipeline that blends a view's rays into its [`AccumulationTarget`].
@@ -159,10 +184,17 @@ pub fn prepare_reduced_targets(
         let texture = textures.get(&device, target_descriptor("focal_reduced_rays", size, format));
         commands.entity(entity).insert((ReducedTarget { texture, size }, UpscalePipelineId(over)));
         if accumulate.is_some() {
-            if kept.is_none_or(|k| k.size != size) {
-                let texture = device.create_texture(&target_descriptor("focal_accumulated_rays", size, ACCUMULATION_FORMAT));
-                let view = texture.create_view(&TextureViewDescriptor::default());
-                commands.entity(entity).insert(AccumulationTarget { texture, view, size });
+            match kept {
+                Some(k) if k.size == size => {
+                    if accumulate.is_some_and(|a| a.index == 0) {
+                        k.blended.restart();
+                    }
+                }
+                _ => {
+                    let texture = device.create_texture(&target_descriptor("focal_accumulated_rays", size, ACCUMULATION_FORMAT));
+                    let view = texture.create_view(&TextureViewDescriptor::default());
+                    commands.entity(entity).insert(AccumulationTarget { texture, view, size, blended: BlendedFrames::default() });
+                }
             }
             commands.entity(entity).insert(AccumulatePipelineId(average));
         }
@@ -196,5 +228,25 @@ mod tests {
         // 801 · 0.25 = 200.25: 201 pixels, so the drawn pixels cover the view.
         assert_eq!(reduced_size(UVec2::new(801, 3), 0.25), UVec2::new(201, 1));
         assert_eq!(reduced_size(UVec2::new(10, 10), 0.0), UVec2::ONE);
+    }
+
+    /// The main world's frame index runs on while the pass cannot draw (a lens's
+    /// pipeline compiling): the average holds only once its frames were blended, and
+    /// is then their mean.
+    #[test]
+    fn an_average_holds_only_after_its_frames_were_blended() {
+        let frame = Accumulate { index: 40, frames: 16 };
+        let blended = BlendedFrames::default();
+        assert!(!frame.holds(blended.get()), "an average of no frames is not held");
+        let mut average = 0.0f32;
+        for value in 0..16 {
+            let w = Accumulate::weight(blended.get());
+            average = w * value as f32 + (1.0 - w) * average;
+            blended.add_one();
+        }
+        assert!((average - 7.5).abs() < 1e-5, "the mean of 0 … 15 is 7.5, not {average}");
+        assert!(frame.holds(blended.get()));
+        blended.restart();
+        assert!(!frame.holds(blended.get()));
     }
 }

@@ -8,7 +8,7 @@ use glam::{Affine3A, EulerRot, Quat, UVec3, Vec3};
 use super::file::{CameraSpec, Change, DatasetSpec, SceneFile, SourceSpec, vec3};
 use crate::clip::Clipping;
 use crate::dataset::Dataset;
-use crate::region::{Appearance, Camera, Lookup, Orbit, Projection, RenderScene, Segmentation, SegmentationSpec, View};
+use crate::region::{Appearance, AppearanceSpec, Camera, Lookup, Orbit, Projection, RenderScene, Segmentation, SegmentationSpec, View};
 use crate::streaming::bricked::{BrickedDataset, StreamBudget};
 use crate::transfer::presets;
 use crate::twolevel::spec::LabelSource;
@@ -180,18 +180,28 @@ fn load_dataset(spec: &DatasetSpec, base: &Path, options: &ReadOptions) -> Resul
     Ok(d)
 }
 
-/// The dataset of a spec's volume: as labels where the spec says so.
-fn labelled(spec: &DatasetSpec, base: &Path, volume: Volume, sidecar_from: Option<PathBuf>) -> Result<LoadedDataset, String> {
-    match &spec.appearance.labels {
+/// The dataset of a spec's volume: as labels where the spec says so, or where the file
+/// carries its own label table (a DICOM segmentation). The table: the spec's, else the
+/// sidecar files', else the file's own, else generated colours.
+fn labelled(spec: &DatasetSpec, base: &Path, mut volume: Volume, sidecar_from: Option<PathBuf>) -> Result<LoadedDataset, String> {
+    let carried = volume.label_table.take();
+    let shown_as = match (&spec.appearance.labels, &carried) {
+        (Some(labels), _) => Some(labels.clone()),
+        (None, Some(_)) => Some(Default::default()),
+        (None, None) => None,
+    };
+    match shown_as {
         Some(labels) => {
-            let table = match (&labels.table, &sidecar_from) {
-                (Some(t), _) => label_table::read(&resolve(base, t)).map_err(|e| e.to_string())?,
-                (None, Some(p)) => label_table::read_sidecars(p).map_err(|e| e.to_string())?,
-                (None, None) => LabelTable::default(),
+            let sidecars = match (&labels.table, &sidecar_from) {
+                (Some(t), _) => Some(label_table::read(&resolve(base, t)).map_err(|e| e.to_string())?),
+                (None, Some(p)) => Some(label_table::read_sidecars(p).map_err(|e| e.to_string())?).filter(|t| !t.is_empty()),
+                (None, None) => None,
             };
+            let table = sidecars.or(carried).unwrap_or_default();
             let lv = LabelVolume::from_volume(volume, table)?;
+            let spec = DatasetSpec { appearance: AppearanceSpec { labels: Some(labels), ..spec.appearance.clone() }, ..spec.clone() };
             let app = spec.appearance.appearance(&lv.volume, Some(&lv.table), base)?;
-            dataset(spec, lv.volume, app, Some(lv.table))
+            dataset(&spec, lv.volume, app, Some(lv.table))
         }
         None => {
             let app = spec.appearance.appearance(&volume, None, base)?;

@@ -56,6 +56,9 @@ pub struct Volume {
     pub values: ValueMap,
     pub stats: ValueStats,
     pub source: Source,
+    /// The names and colours of label ids the file itself carries (a DICOM
+    /// segmentation's segments): such a volume is shown as labels.
+    pub label_table: Option<labels::LabelTable>,
     /// Length (mm) that transfer-function opacities are given for; `None`: the
     /// smallest voxel spacing ([`Volume::opacity_reference`]).
     opacity_reference: Option<f32>,
@@ -74,6 +77,7 @@ impl Clone for Volume {
             values: self.values.clone(),
             stats: self.stats.clone(),
             source: self.source.clone(),
+            label_table: self.label_table.clone(),
             opacity_reference: self.opacity_reference,
             bricks: self.bricks.clone(),
             level_one_bricks: self.level_one_bricks.clone(),
@@ -117,12 +121,18 @@ impl Volume {
             values,
             stats,
             source,
+            label_table: None,
             opacity_reference: None,
             bricks: OnceLock::new(),
             level_one_bricks: OnceLock::new(),
             gradient_max: OnceLock::new(),
             pyramid: OnceLock::new(),
         })
+    }
+
+    /// The volume as labels with the table its file carries.
+    pub fn with_label_table(self, table: labels::LabelTable) -> Volume {
+        Volume { label_table: Some(table), ..self }
     }
 
     pub fn dims(&self) -> UVec3 {

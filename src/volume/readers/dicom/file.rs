@@ -208,7 +208,7 @@ pub(super) fn pixel_bytes<'a>(object: &'a DefaultDicomObject, format: &PixelForm
             use dicom_pixeldata::PixelDecoder;
             let decoded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| object.decode_pixel_data()))
                 .map_err(|_| Problem::Corrupt("the pixel data decoder failed on this data".into()))?
-                .map_err(|e| Problem::Unsupported(format!("pixel data: {e}")))?;
+                .map_err(|e| Problem::Unsupported(format!("pixel data in transfer syntax {}: {}", transfer_syntax(object), chain(&e))))?;
             Cow::Owned(decoded.data().to_vec())
         }
     };
@@ -228,6 +228,30 @@ pub(super) fn pixel_bytes<'a>(object: &'a DefaultDicomObject, format: &PixelForm
             Cow::Owned(b)
         }
     })
+}
+
+/// An object's transfer syntax: its UID and, where the registry knows it, its name.
+fn transfer_syntax(object: &DefaultDicomObject) -> String {
+    let uid = object.meta().transfer_syntax().trim_end_matches('\0');
+    use dicom_transfer_syntax_registry::TransferSyntaxIndex;
+    match dicom_transfer_syntax_registry::TransferSyntaxRegistry.get(uid) {
+        Some(ts) => format!("{uid} ({})", ts.name()),
+        None => uid.to_string(),
+    }
+}
+
+/// An error with the errors under it (the decoders say what failed only there).
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        let next = s.to_string();
+        if !text.contains(&next) {
+            text += &format!(": {next}");
+        }
+        source = s.source();
+    }
+    text
 }
 
 #[cfg(test)]

@@ -12,7 +12,10 @@
 //! reserved bytes and a 4-byte length; implicit VR has a 4-byte length. Items and
 //! delimiters (group FFFE) have a 4-byte length and no VR. `0xFFFFFFFF` is an undefined
 //! length (sequences, items, encapsulated pixel data), closed by a delimiter. The file
-//! meta group is always explicit VR little endian.
+//! meta group is always explicit VR little endian. In the deflated transfer syntax
+//! (1.2.840.10008.1.2.1.99, PS3.5 §A.5) the data set after it is a raw deflate stream
+//! of explicit VR little endian: it is inflated (at most [`MAX_INFLATED`] bytes) and
+//! walked so.
 
 use super::super::common::Problem;
 
@@ -20,6 +23,15 @@ use super::super::common::Problem;
 const MAX_DEPTH: usize = 24;
 
 const UNDEFINED: u32 = 0xFFFF_FFFF;
+
+/// The Pixel Data element.
+const PIXEL_DATA: Tag = (0x7FE0, 0x0010);
+
+/// Most bytes a deflated data set may inflate to (the parser holds it whole).
+pub const MAX_INFLATED: u64 = 4 << 30;
+
+/// The deflated explicit VR little endian transfer syntax.
+const DEFLATED: &str = "1.2.840.10008.1.2.1.99";
 
 /// Encoding of the data set after the meta group.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,7 +64,7 @@ struct Header {
 pub fn check(bytes: &[u8]) -> Result<String, Problem> {
     let (start, _) = meta_start(bytes)?;
     let meta = Encoding { explicit: true, big_endian: false };
-    let mut w = Walker { bytes, pos: start, enc: meta };
+    let mut w = Walker { bytes, pos: start, enc: meta, fragments: false };
     // Meta group: group 0002 elements.
     let mut ts = None;
     while w.pos + 4 <= bytes.len() && w.u16_at(w.pos) == 0x0002 {
@@ -68,17 +80,38 @@ pub fn check(bytes: &[u8]) -> Result<String, Problem> {
     w.enc = match ts.as_str() {
         "1.2.840.10008.1.2" => Encoding { explicit: false, big_endian: false },
         "1.2.840.10008.1.2.2" => Encoding { explicit: true, big_endian: true },
-        "1.2.840.10008.1.2.1.99" => return Err(Problem::Unsupported("deflated transfer syntax".into())),
         _ => Encoding { explicit: true, big_endian: false },
     };
-    w.walk(bytes.len(), 0)?;
+    if ts == DEFLATED {
+        let inflated = inflate(&bytes[w.pos..], MAX_INFLATED)?;
+        Walker { bytes: &inflated, pos: 0, enc: w.enc, fragments: false }.walk(inflated.len(), 0)?;
+    } else {
+        w.walk(bytes.len(), 0)?;
+    }
     Ok(ts)
+}
+
+/// A raw deflate stream inflated, refused past `limit` bytes or where it is corrupt.
+fn inflate(stream: &[u8], limit: u64) -> Result<Vec<u8>, Problem> {
+    use std::io::Read;
+    let mut out = Vec::new();
+    flate2::read::DeflateDecoder::new(stream)
+        .take(limit + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| Problem::Corrupt(format!("the deflated data set does not inflate: {e}")))?;
+    if out.len() as u64 > limit {
+        return Err(Problem::TooLarge(format!("a deflated data set inflating to more than {limit} bytes")));
+    }
+    Ok(out)
 }
 
 struct Walker<'a> {
     bytes: &'a [u8],
     pos: usize,
     enc: Encoding,
+    /// Whether the items of the level walked are pixel-data fragments (inside
+    /// encapsulated Pixel Data: compressed bytes, not walked) rather than data sets.
+    fragments: bool,
 }
 
 type Tag = (u16, u16);
@@ -160,15 +193,17 @@ impl Walker<'_> {
                     return Ok(());
                 }
                 (_, None) => {
-                    // Undefined length: a sequence, an item, or encapsulated pixel data.
-                    // An explicit-VR UN of undefined length holds an implicit-VR sequence.
-                    let outer = self.enc;
+                    // Undefined length: a sequence, an item, or encapsulated pixel data
+                    // (OB or OW: its items are fragments). An explicit-VR UN of undefined
+                    // length holds an implicit-VR sequence.
+                    let (outer, outer_fragments) = (self.enc, self.fragments);
                     if vr == Some(*b"UN") {
                         self.enc = Encoding { explicit: false, big_endian: false };
                     }
+                    self.fragments = tag == PIXEL_DATA || matches!(vr, Some([b'O', b'B' | b'W']));
                     self.pos = value_at;
                     self.walk(end, depth + 1)?;
-                    self.enc = outer;
+                    (self.enc, self.fragments) = (outer, outer_fragments);
                 }
                 (_, Some(len)) => {
                     let len = len as usize;
@@ -176,14 +211,17 @@ impl Walker<'_> {
                     if value_at.checked_add(len).is_some_and(|e| e > end) {
                         return Err(Problem::Malformed(format!("element ({:04X},{:04X}) overruns its enclosing item", tag.0, tag.1)));
                     }
+                    // (An item of a sequence is a data set; a sequence's content, items.)
                     let inside = if tag == (0xFFFE, 0xE000) {
-                        self.looks_like_element(value_at, len)
+                        !self.fragments
                     } else {
                         vr == Some(*b"SQ") || (vr.is_none() && self.starts_with_item(value_at, len))
                     };
                     if inside {
+                        let outer_fragments = std::mem::replace(&mut self.fragments, false);
                         self.pos = value_at;
                         self.walk(value_at + len, depth + 1)?;
+                        self.fragments = outer_fragments;
                     }
                     self.pos = value_at + len;
                 }
@@ -194,21 +232,6 @@ impl Walker<'_> {
 
     fn starts_with_item(&self, at: usize, len: usize) -> bool {
         len >= 8 && self.u16_at(at) == 0xFFFE && self.u16_at(at + 2) == 0xE000
-    }
-
-    /// An item's content is a data set (sequence item) unless it is a pixel-data fragment;
-    /// fragments hold compressed bytes, which are not walked.
-    fn looks_like_element(&self, at: usize, len: usize) -> bool {
-        if len < 8 {
-            return false;
-        }
-        let group = self.u16_at(at);
-        // A nested data set starts with an even group number (not FFFE) in ascending order;
-        // JPEG fragments start with FF D8, RLE with a small header count.
-        group.is_multiple_of(2)
-            && group != 0xFFFE
-            && (0x0008..0x7FE1).contains(&group)
-            && (!self.enc.explicit || self.bytes[at + 4].is_ascii_uppercase())
     }
 }
 
@@ -265,5 +288,48 @@ mod tests {
         }
         let f = file("1.2.840.10008.1.2", &body);
         assert!(matches!(check(&f), Err(Problem::Malformed(_))));
+    }
+
+    #[test]
+    fn deflated_data_sets_are_walked_inflated() {
+        use std::io::Write;
+        let deflate = |body: &[u8]| {
+            let mut e = flate2::write::DeflateEncoder::new(Vec::new(), flate2::Compression::default());
+            e.write_all(body).unwrap();
+            e.finish().unwrap()
+        };
+        let name = element_explicit(0x0010, 0x0010, b"PN", b"DOE^J ");
+        assert_eq!(check(&file(DEFLATED, &deflate(&name))).unwrap(), DEFLATED);
+        // An overlong length inside the deflated set is found as in a plain one.
+        let mut overlong = element_explicit(0x7FE0, 0x0010, b"OW", &[0u8; 16]);
+        overlong[8..12].copy_from_slice(&0xFFFF_FFF0u32.to_le_bytes());
+        assert!(matches!(check(&file(DEFLATED, &deflate(&overlong))), Err(Problem::Truncated(_))));
+        // Not a deflate stream; one that inflates past the limit.
+        assert!(matches!(check(&file(DEFLATED, &[0xFF; 40])), Err(Problem::Corrupt(_))));
+        assert!(matches!(inflate(&deflate(&[0u8; 5000]), 4096), Err(Problem::TooLarge(_))));
+        assert_eq!(inflate(&deflate(&[7u8; 4096]), 4096).unwrap(), vec![7u8; 4096]);
+    }
+
+    /// An item of a sequence is a data set, walked whatever its first bytes look like
+    /// (a corrupted VR there made the parser read a length of hundreds of megabytes);
+    /// the fragments of encapsulated pixel data are not.
+    #[test]
+    fn sequence_items_are_walked_and_fragments_are_not() {
+        let item = |content: &[u8]| {
+            let mut v = vec![0xFE, 0xFF, 0x00, 0xE0];
+            v.extend_from_slice(&(content.len() as u32).to_le_bytes());
+            v.extend_from_slice(content);
+            v
+        };
+        let mut bad_vr = element_explicit(0x0018, 0x0050, b"DS", b"2.5 ");
+        bad_vr[4] = b'9';
+        let sequence = element_explicit(0x0028, 0x9110, b"SQ", &item(&bad_vr));
+        assert!(matches!(check(&file("1.2.840.10008.1.2.1", &sequence)), Err(Problem::Malformed(_))));
+        // Encapsulated pixel data: an empty offset table, then a fragment of any bytes.
+        let mut pixels = vec![0xE0, 0x7F, 0x10, 0x00, b'O', b'B', 0, 0, 0xFF, 0xFF, 0xFF, 0xFF];
+        pixels.extend(item(&[]));
+        pixels.extend(item(&bad_vr));
+        pixels.extend_from_slice(&[0xFE, 0xFF, 0xDD, 0xE0, 0, 0, 0, 0]);
+        assert!(check(&file("1.2.840.10008.1.2.4.50", &pixels)).is_ok(), "{:?}", check(&file("1.2.840.10008.1.2.4.50", &pixels)));
     }
 }

@@ -14,12 +14,16 @@
 //!   direction times Pixel Spacing[1]. Stored values are masked to Bits Stored and sign
 //!   extended when Pixel Representation is 1; Rescale Slope/Intercept give real values
 //!   (Hounsfield units for CT). Positions are LPS and are flipped into Focal's RAS world.
-//! - Compressed transfer syntaxes (JPEG, JPEG-LS lossless, RLE, …) are decoded by
-//!   `dicom-pixeldata`; a decoder panic on bad data is caught and reported.
+//! - Compressed transfer syntaxes (JPEG baseline and 8-bit extended, JPEG lossless, RLE)
+//!   are decoded by `dicom-pixeldata` (32-bit RLE by [`rle`]); a decoder panic on bad
+//!   data is caught and reported, and a transfer syntax without a decoder is named.
+//!   Deflated data sets are inflated by the parser (and bounded by the guard first).
+//! - Segmentations and other 1-bit images are label volumes ([`segmentation`]).
 
 mod file;
 pub mod guard;
 mod rle;
+pub mod segmentation;
 mod series;
 
 use std::path::{Path, PathBuf};
@@ -42,6 +46,9 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<Volume, ReadError> {
         return series::read_series(path, &files, options);
     }
     let object = open(path, options)?;
+    if segmentation::applies(&object) {
+        return segmentation::read(path, object, options);
+    }
     let frames = int(&object, tags::NUMBER_OF_FRAMES).unwrap_or(1);
     if frames > 1 {
         return series::read_multiframe(path, object, options);

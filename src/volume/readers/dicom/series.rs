@@ -24,7 +24,7 @@ pub struct FrameGeometry {
     pub intercept: f64,
 }
 
-fn frame_geometry(o: &InMemDicomObject, frame: Option<usize>) -> FrameGeometry {
+pub(super) fn frame_geometry(o: &InMemDicomObject, frame: Option<usize>) -> FrameGeometry {
     let get = |seq, tag| match frame {
         Some(f) => group_value(o, f, seq, tag).and_then(|e| e.to_multi_float64().ok()).filter(|v| v.iter().all(|x| x.is_finite())),
         None => floats(o, tag),
@@ -56,10 +56,10 @@ fn frame_geometry(o: &InMemDicomObject, frame: Option<usize>) -> FrameGeometry {
 }
 
 /// One slice (file) or frame with its pixels.
-struct Plane {
-    geometry: FrameGeometry,
-    instance: i64,
-    bytes: Vec<u8>,
+pub(super) struct Plane {
+    pub(super) geometry: FrameGeometry,
+    pub(super) instance: i64,
+    pub(super) bytes: Vec<u8>,
 }
 
 /// Reads every DICOM file in `files` and assembles the largest series.
@@ -242,7 +242,7 @@ pub fn read_multiframe(path: &Path, object: DefaultDicomObject, options: &ReadOp
 }
 
 /// Sorts planes along the slice normal, derives the grid and encodes the voxels.
-fn assemble(
+pub(super) fn assemble(
     at: &Path,
     first: &DefaultDicomObject,
     format: PixelFormat,
