@@ -10,6 +10,7 @@ pub mod bricks;
 pub mod convert;
 pub mod encode;
 pub mod grid;
+pub mod label_table;
 pub mod labels;
 pub mod phantom;
 pub mod pyramid;
@@ -58,7 +59,7 @@ pub struct Volume {
     pub source: Source,
     /// The names and colours of label ids the file itself carries (a DICOM
     /// segmentation's segments): such a volume is shown as labels.
-    pub label_table: Option<labels::LabelTable>,
+    pub label_table: Option<label_table::LabelTable>,
     /// Length (mm) that transfer-function opacities are given for; `None`: the
     /// smallest voxel spacing ([`Volume::opacity_reference`]).
     opacity_reference: Option<f32>,
@@ -131,7 +132,7 @@ impl Volume {
     }
 
     /// The volume as labels with the table its file carries.
-    pub fn with_label_table(self, table: labels::LabelTable) -> Volume {
+    pub fn with_label_table(self, table: label_table::LabelTable) -> Volume {
         Volume { label_table: Some(table), ..self }
     }
 
