@@ -38,6 +38,10 @@ struct Args {
     /// without asking.
     #[arg(long, conflicts_with = "volume")]
     restore: bool,
+    /// (Testing) Destroy the GPU device after this many drawn frames, as a driver reset
+    /// does: the app must keep the view and say why it stops.
+    #[arg(long, hide = true)]
+    lose_device_after: Option<u64>,
 }
 
 #[derive(Subcommand)]
@@ -72,7 +76,8 @@ fn main() -> ExitCode {
                 eprintln!("error: window size '{}' is not WIDTHxHEIGHT", args.window);
                 return ExitCode::FAILURE;
             };
-            match focal::ui::run(args.volume.clone(), automation, window, (args.slices, args.restore)) {
+            let options = focal::ui::RunOptions { slices: args.slices, restore: args.restore, lose_device_after: args.lose_device_after };
+            match focal::ui::run(args.volume.clone(), automation, window, options) {
                 bevy::app::AppExit::Success => Ok(()),
                 bevy::app::AppExit::Error(code) => Err(format!("the app stopped with code {code}")),
             }

@@ -530,6 +530,53 @@ fn the_slices_of_a_streamed_pyramid_show_its_native_voxels() {
     assert!((equal as f64) < 0.45 * pairs as f64, "blocky slices: {equal} of {pairs} pairs equal in {}", shot.display());
 }
 
+/// A lost GPU device (the app destroys its own, as a driver reset does): the app says
+/// why it stops and exits with an error, and leaves its view, with the reason, for the
+/// next start to offer.
+#[test]
+fn a_lost_device_leaves_a_message_and_the_session() {
+    let dir = scratch("app-device-lost");
+    let scene = dir.join("engine-lens.ron");
+    std::fs::write(
+        &scene,
+        r#"(datasets: [(source: Phantom(kind: engine, resolution: 48), appearance: (mode: dvr, preset: Some("industrial_ct")))],
+            lenses: [(kind: magnifier(magnification: 2.0), center: (0.1, 0.0), radius: 0.25)])"#,
+    )
+    .unwrap();
+    let config = dir.join("config");
+    let mut app = app_in_xvfb("1024x768", &config)
+        .arg(&scene)
+        .args(["--window", "800x500", "--lose-device-after", "10"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // (The app must end by itself: a hang after the loss is a failure, not a wait.)
+    let started = std::time::Instant::now();
+    let status = loop {
+        if let Some(s) = app.try_wait().unwrap() {
+            break Some(s);
+        }
+        if started.elapsed() > Duration::from_secs(240) {
+            let _ = app.kill();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    };
+    let mut log = String::new();
+    let _ = std::io::Read::read_to_string(&mut app.stderr.take().unwrap(), &mut log);
+    let status = status.unwrap_or_else(|| panic!("the app did not end within 240 s of losing its device:\n{log}"));
+    assert!(!status.success(), "a lost device is an error exit:\n{log}");
+    // (Bevy reports the loss to the render error handler, or its own readbacks panic
+    // on the destroyed device first: either way the app says it stopped, and why.)
+    assert!(log.contains("Focal stopped: the graphics device was lost") || log.contains("Focal stopped: the renderer failed"), "{log}");
+    let recovery = config.join("recovery.ron");
+    let saved = focal::scene::read_scene(&recovery).unwrap_or_else(|e| panic!("the view is kept ({e}):\n{log}"));
+    assert_eq!((saved.datasets.len(), saved.lenses.len()), (1, 1));
+    let reason = std::fs::read_to_string(config.join("recovery-reason.txt")).unwrap();
+    assert!(reason.contains("the graphics device was lost") || reason.contains("the renderer failed"), "{reason}");
+}
+
 /// A session killed with SIGKILL comes back: the app writes its view for recovery while
 /// it runs (and removes it when it exits cleanly); `focal --restore` opens it, and shows
 /// what the killed session showed.

@@ -340,6 +340,7 @@ fn two_datasets_in_one_scene(gpu: &mut Gpu) {
 }
 
 fn oversized_volumes_are_reduced_with_a_warning(gpu: &mut Gpu) {
+    let before = *gpu.off.world_mut().resource::<focal::dataset::gpu_fit::GpuLimits>();
     gpu.off.world_mut().insert_resource(focal::dataset::gpu_fit::GpuLimits { max_dimension: 32, max_bytes: 1 << 30 });
     let h = head();
     let a = Appearance::new(Mode::Dvr, presets::builtin("ct_bone").unwrap());
@@ -350,7 +351,47 @@ fn oversized_volumes_are_reduced_with_a_warning(gpu: &mut Gpu) {
     assert_eq!(warnings.len(), 1);
     assert!(warnings[0].contains("1/2 resolution"), "{}", warnings[0]);
     assert!(img.pixels().any(|p| p[0] > 100), "the reduced volume is still drawn");
-    gpu.off.world_mut().insert_resource(focal::dataset::gpu_fit::GpuLimits::default());
+    gpu.off.world_mut().insert_resource(before);
+}
+
+/// Limits that promise more than the device holds (as a driver that overstates its
+/// memory would): the atlas of a rod longer than the device's 3D textures is refused
+/// inside the upload's error scopes (not by wgpu's uncaptured-error path, which quits);
+/// the limits come down below it and the rod is drawn halved, with a message.
+fn a_volume_the_device_refuses_comes_back_reduced_with_a_message(gpu: &mut Gpu) {
+    use focal::dataset::gpu_fit::GpuLimits;
+    use focal::render::health::{GpuMessages, RenderHealth};
+    let world = gpu.off.world_mut();
+    let device_max = world.resource::<bevy::render::renderer::RenderDevice>().limits().max_texture_dimension_3d;
+    let before = *world.resource::<GpuLimits>();
+    world.insert_resource(GpuLimits { max_dimension: device_max * 2, max_bytes: 1 << 30 });
+    world.resource_mut::<GpuMessages>().0.clear();
+    // A rod 8 voxels longer than the device's textures, 32 × 32 across with a bright
+    // core, 64 mm long.
+    let n = device_max + 8;
+    let codes: Vec<u8> = (0..n as usize * 32 * 32)
+        .map(|i| {
+            let (y, z) = ((i / n as usize) % 32, i / (n as usize * 32));
+            if (8..24).contains(&y) && (8..24).contains(&z) { 200 } else { 0 }
+        })
+        .collect();
+    let grid = Grid::new(UVec3::new(n, 32, 32), Vec3::new(64.0 / n as f32, 1.0, 1.0));
+    let rod = Arc::new(Volume::new("rod", grid, Voxels::U8(codes), ValueMap::IDENTITY, Source::default()).unwrap());
+    let a = Appearance::new(Mode::Mip, presets::builtin("grayscale_ramp").unwrap());
+    let img = gpu.show(rod.clone(), a, &framed(&rod, View::Anterior, false));
+    let world = gpu.off.world_mut();
+    let messages = world.resource::<GpuMessages>().0.clone();
+    let limits = *world.resource::<GpuLimits>();
+    let warnings: Vec<String> = world.query::<&focal::dataset::GpuVolume>().iter(world).filter_map(|g| g.warning.clone()).collect();
+    let stopped = world.resource::<RenderHealth>().stopped();
+    world.insert_resource(before);
+    world.resource_mut::<GpuMessages>().0.clear();
+    println!("    device 3D textures up to {device_max}; messages: {messages:?}; warnings: {warnings:?}");
+    assert_eq!(stopped, None, "rendering goes on");
+    assert!(messages.iter().any(|m| m.contains("the GPU refused the volume textures")), "{messages:?}");
+    assert!(limits.max_dimension < n && limits.max_dimension <= device_max, "{limits:?}");
+    assert!(warnings.iter().any(|w| w.contains("1/2 resolution")), "{warnings:?}");
+    assert!(img.pixels().filter(|p| p[0] > 100).count() > 50, "the halved rod is drawn");
 }
 
 /// A GPU test: its name and the function that runs it on the shared device.
@@ -369,7 +410,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 36] = [
+    let tests: [GpuTest; 37] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -377,6 +418,7 @@ fn main() {
         ("meshes_and_volume_mix_by_depth", meshes_and_volume_mix_by_depth),
         ("two_datasets_in_one_scene", two_datasets_in_one_scene),
         ("oversized_volumes_are_reduced_with_a_warning", oversized_volumes_are_reduced_with_a_warning),
+        ("a_volume_the_device_refuses_comes_back_reduced_with_a_message", a_volume_the_device_refuses_comes_back_reduced_with_a_message),
         ("lenses_match_the_reference", lenses::lenses_match_the_reference),
         ("lens_ray_directions_match_the_reference", lenses::ray_directions_match_the_reference),
         ("magnifier_scales_a_sphere_by_m_squared", lenses::magnifier_scales_a_sphere_by_m_squared),

@@ -92,6 +92,9 @@ pub struct ExtractedScene {
     /// The bricked frame of each of the scene's volumes (`None`: in memory).
     pub bricked: Vec<Option<BrickFrame>>,
     pub budget: StreamBudget,
+    /// What the main world fits datasets to (the device's limits, lowered after a
+    /// refusal): the packing keeps to it too.
+    pub limits: crate::dataset::gpu_fit::GpuLimits,
 }
 
 /// Copies the scene regions into the render world (shared volumes, small vectors), and
@@ -101,10 +104,12 @@ pub fn extract_scene(
     scene: Extract<Res<SceneRegions>>,
     bricked: Extract<Option<Res<BrickedScene>>>,
     budget: Extract<Option<Res<StreamBudget>>>,
+    limits: Extract<Option<Res<crate::dataset::gpu_fit::GpuLimits>>>,
 ) {
     commands.insert_resource(ExtractedScene {
         scene: scene.scene.clone(),
         bricked: bricked.as_ref().map(|b| b.volumes.clone()).unwrap_or_default(),
         budget: budget.as_deref().copied().unwrap_or_default(),
+        limits: limits.as_deref().copied().unwrap_or_default(),
     });
 }

@@ -184,7 +184,7 @@ impl Offscreen {
         let mut frames = 0;
         loop {
             self.update();
-            if let Some(e) = self.pipeline_error() {
+            if let Some(e) = self.pipeline_error().or_else(|| self.stopped()) {
                 return Err(e);
             }
             if self.ready() {
@@ -233,6 +233,11 @@ impl Offscreen {
         image
     }
 
+    /// Why rendering stopped (a lost device), if it did.
+    fn stopped(&self) -> Option<String> {
+        self.app.world().get_resource::<super::health::RenderHealth>().and_then(|h| h.stopped())
+    }
+
     /// Runs frames until the volumes are drawn once (whatever streaming has brought by
     /// then); the frames it took.
     pub fn first_frame(&mut self) -> Result<u32, String> {
@@ -240,7 +245,7 @@ impl Offscreen {
         let before = progress.volumes_drawn();
         for k in 1..=MAX_WAIT_FRAMES {
             self.update();
-            if let Some(e) = self.pipeline_error() {
+            if let Some(e) = self.pipeline_error().or_else(|| self.stopped()) {
                 return Err(e);
             }
             if self.ready() && progress.volumes_drawn() > before {

@@ -14,6 +14,10 @@
 //!   premultiplied result over the meshes; a view drawn at a reduced resolution
 //!   ([`reduced`]) has its rays drawn into a smaller texture, then upscaled over it.
 //!
+//! - [`health`] keeps what the device refused (uploads run inside error scopes; the
+//!   limits are lowered and the datasets fitted again) and whether rendering stopped
+//!   (a lost device), for the app and the headless renderer to act on.
+//!
 //! The renderer packs; it does not decide: what is drawn where is the techniques'
 //! business (datasets, windows, exploded parts), expressed as regions.
 
@@ -23,6 +27,7 @@ pub mod extract;
 pub mod feature_pass;
 pub mod gpu_types;
 pub mod headless;
+pub mod health;
 pub mod lens_pack;
 pub mod pack;
 pub mod pass;
@@ -53,15 +58,25 @@ impl Plugin for VolumeRenderPlugin {
         shaders::register(app);
 
         let progress = RenderProgress::default();
+        let health = health::RenderHealth::default();
         app.init_resource::<GpuLimits>()
             .insert_resource(progress.clone())
+            .insert_resource(health.clone())
+            .insert_resource(health::error_handler())
+            .init_resource::<health::GpuMessages>()
             .add_plugins((
                 ExtractComponentPlugin::<VolumeView>::default(),
                 ExtractComponentPlugin::<crate::lens::ViewLenses>::default(),
                 ExtractComponentPlugin::<crate::dataset::view::Accumulate>::default(),
                 UniformComponentPlugin::<GpuSettings>::default(),
             ))
-            .add_systems(PostUpdate, (extract::request_depth_binding, fit_datasets.before(crate::dataset::RegionSystems::Collect)));
+            .add_systems(
+                PostUpdate,
+                (
+                    extract::request_depth_binding,
+                    (health::lower_limits_after_refusals, fit_datasets).chain().before(crate::dataset::RegionSystems::Collect),
+                ),
+            );
 
         let status = app.world().get_resource::<crate::streaming::bricked::StreamStatus>().cloned().unwrap_or_default();
         let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
@@ -69,6 +84,7 @@ impl Plugin for VolumeRenderPlugin {
         };
         render_app
             .insert_resource(progress)
+            .insert_resource(health)
             .insert_resource(status)
             .init_resource::<upload::GpuScene>()
             .init_resource::<bricked::atlas::BrickAtlas>()

@@ -50,6 +50,8 @@ pub struct GpuScene {
     pub bricked_directory: Vec<usize>,
     /// The coarse level of each bricked scene volume the packing saw.
     bricked_key: Vec<Option<usize>>,
+    /// The volumes (as `atlas_key`) of a scene the device refused to hold.
+    refused_key: Option<Vec<usize>>,
 }
 
 impl GpuScene {
@@ -73,6 +75,7 @@ pub fn upload_scene(
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
     adapter: Res<RenderAdapter>,
+    health: Res<super::health::RenderHealth>,
     mut gpu: ResMut<GpuScene>,
 ) {
     let Some(extracted) = extracted else { return };
@@ -81,7 +84,7 @@ pub fn upload_scene(
     if gpu.last.as_ref().is_some_and(|last| same_scene(last, scene)) && gpu.ready() && gpu.bricked_key == bricked_key {
         return;
     }
-    let mut packed = match pack(scene, device.limits().max_texture_dimension_3d) {
+    let mut packed = match pack(scene, extracted.limits.max_dimension) {
         Ok(p) => p,
         Err(e) => {
             error!("cannot draw the scene: {e}");
@@ -106,12 +109,37 @@ pub fn upload_scene(
         .map(|&v| Arc::as_ptr(&all[v]) as usize)
         .chain(seconds.clone().map(|s| s.map_or(0, |s| s as *const Volume as usize)))
         .collect();
-    if gpu.atlas_key != key || gpu.atlases.is_none() {
-        let volumes: Vec<(&Volume, Option<&Volume>)> = packed.volumes.iter().map(|&v| all[v].as_ref()).zip(seconds).collect();
-        gpu.atlases = Some(atlases(&device, &queue, &volumes, &packed, sixteen_bit_formats(&adapter)));
-        gpu.atlas_key = key;
+    // (A scene the device refused waits for its volumes to change: fitted smaller.)
+    if gpu.refused_key.as_ref() == Some(&key) {
+        return;
     }
-    write_buffers(&device, &queue, &packed, &mut gpu);
+    let volumes: Vec<(&Volume, Option<&Volume>)> = packed.volumes.iter().map(|&v| all[v].as_ref()).zip(seconds).collect();
+    let new_atlases = gpu.atlas_key != key || gpu.atlases.is_none();
+    let uploaded = super::health::scoped(&device, || {
+        let made = new_atlases.then(|| atlases(&device, &queue, &volumes, &packed, sixteen_bit_formats(&adapter)));
+        write_buffers(&device, &queue, &packed, &mut gpu);
+        made
+    });
+    match uploaded {
+        Ok(Some(made)) => {
+            gpu.atlases = Some(made);
+            gpu.atlas_key = key;
+        }
+        Ok(None) => {}
+        Err(reason) => {
+            let size = packed.atlas.size.as_u64vec3();
+            health.refuse(super::health::Refusal {
+                what: super::health::Refused::Volumes,
+                reason,
+                largest_edge: packed.atlas.size.max_element(),
+                bytes: size.x * size.y * size.z * texel_bytes(&volumes) as u64,
+            });
+            // Nothing of it is bound: the pass draws nothing until smaller volumes come.
+            *gpu = GpuScene { refused_key: Some(key), ..Default::default() };
+            return;
+        }
+    }
+    gpu.refused_key = None;
     gpu.region_count = packed.region_count;
     gpu.features = packed.features;
     gpu.dropped = packed.dropped;
@@ -203,6 +231,13 @@ fn atlases(
     }
     let (bt, bv) = texture_3d(device, queue, "focal brick atlas", bsize, TextureFormat::Rg16Uint, &bricks);
     GpuAtlases { volumes: vv, bricks: bv, _textures: (vt, bt) }
+}
+
+/// Bytes of one texel of the volume atlas ([`volume_texels`]'s format).
+fn texel_bytes(volumes: &[(&Volume, Option<&Volume>)]) -> usize {
+    let channels = if volumes.iter().any(|(_, s)| s.is_some()) { 2 } else { 1 };
+    let sixteen = volumes.iter().flat_map(|(v, s)| std::iter::once(*v).chain(*s)).any(|v| v.voxels.bits() == 16);
+    channels * if sixteen { 2 } else { 1 }
 }
 
 /// The volume atlas's format and texels ([`atlases`]).

@@ -33,11 +33,28 @@ pub struct FocalAppPlugin {
     pub slices: bool,
     /// Restore the last session's view if it did not end cleanly (`focal --restore`).
     pub restore: bool,
+    /// (Testing) Destroy the GPU device after this many drawn frames.
+    pub lose_device_after: Option<u64>,
+}
+
+/// How the app starts, beyond what it opens.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RunOptions {
+    /// The slice views shown.
+    pub slices: bool,
+    /// Restore the last session's view (`focal --restore`).
+    pub restore: bool,
+    /// (Testing) Destroy the GPU device after this many drawn frames, as a driver reset
+    /// does (`focal --lose-device-after N`).
+    pub lose_device_after: Option<u64>,
 }
 
 impl Plugin for FocalAppPlugin {
     fn build(&self, app: &mut App) {
         let initial = self.initial.clone();
+        if let Some(frames) = self.lose_device_after {
+            app.insert_resource(super::gpu_status::LoseDeviceAfter(frames));
+        }
         app.add_plugins((EguiPlugin::default(), FrameTimeDiagnosticsPlugin::default(), LoadingPlugin))
             .insert_resource(AppState { screenshot_and_exit: self.screenshot_and_exit.clone(), ..Default::default() })
             .init_resource::<PointerInViewport>()
@@ -75,6 +92,7 @@ impl Plugin for FocalAppPlugin {
                 },
             )
             .add_systems(Last, super::recovery::remove_on_exit)
+            .add_systems(Update, (super::gpu_status::lose_device, super::gpu_status::quit_when_rendering_stops))
             .add_systems(
                 Update,
                 (
@@ -111,7 +129,13 @@ impl Plugin for FocalAppPlugin {
             )
             .add_systems(
                 EguiPrimaryContextPass,
-                (panels::ui, explode_panel::explode_panel, explode_overlay::explode_overlay, super::streaming_status::streaming_status)
+                (
+                    panels::ui,
+                    explode_panel::explode_panel,
+                    explode_overlay::explode_overlay,
+                    super::streaming_status::streaming_status,
+                    super::gpu_status::gpu_status,
+                )
                     .chain(),
             );
     }
@@ -375,18 +399,15 @@ fn automation(
 }
 
 /// Runs the app.
-pub fn run(
-    initial: Option<PathBuf>,
-    screenshot_and_exit: Option<(u32, PathBuf)>,
-    window: (u32, u32),
-    (slices, restore): (bool, bool),
-) -> AppExit {
+pub fn run(initial: Option<PathBuf>, screenshot_and_exit: Option<(u32, PathBuf)>, window: (u32, u32), options: RunOptions) -> AppExit {
+    let RunOptions { slices, restore, lose_device_after } = options;
+    super::recovery::install_panic_hook();
     App::new()
         .add_plugins(DefaultPlugins.set(WindowPlugin {
             primary_window: Some(Window { title: "Focal".into(), resolution: window.into(), ..default() }),
             ..default()
         }))
         .add_plugins((crate::FocalPlugins, crate::windows::frames::WindowFramePlugin))
-        .add_plugins(FocalAppPlugin { initial, screenshot_and_exit, slices, restore })
+        .add_plugins(FocalAppPlugin { initial, screenshot_and_exit, slices, restore, lose_device_after })
         .run()
 }

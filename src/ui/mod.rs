@@ -16,6 +16,7 @@ pub mod explode_overlay;
 pub mod explode_panel;
 pub mod explode_selection;
 pub mod explode_tools;
+pub mod gpu_status;
 pub mod lenses;
 pub mod loading;
 pub mod movie;
@@ -35,5 +36,5 @@ pub mod viewport;
 pub mod window_tools;
 pub mod windows_panel;
 
-pub use app::{FocalAppPlugin, run};
+pub use app::{FocalAppPlugin, RunOptions, run};
 pub use state::{AppState, DialogPurpose, MainCamera, SHORTCUTS};

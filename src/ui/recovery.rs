@@ -8,8 +8,16 @@
 //! finds one (the last session did not end cleanly) moves it aside to
 //! `recovery-previous.ron`, out of this session's way, and offers to restore it;
 //! `focal --restore` restores it at once.
+//!
+//! When rendering stops (a lost device, [`super::gpu_status`]), the view is written at
+//! once and kept through the app's exit, with the reason beside it
+//! (`recovery-reason.txt`), which the offer at the next start shows. A panic anywhere
+//! (a driver failing under the renderer's own readbacks, a bug) keeps the last copy
+//! too, and [`install_panic_hook`] writes what happened as the reason.
 
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use bevy::prelude::*;
@@ -21,6 +29,58 @@ use crate::scene::SceneFile;
 /// How often the view is written when it changed.
 pub const EVERY: Duration = Duration::from_secs(3);
 
+/// The file beside the recovery file that says why the session stopped.
+const REASON: &str = "recovery-reason.txt";
+/// The same, beside the last session's view moved aside.
+const PREVIOUS_REASON: &str = "recovery-previous-reason.txt";
+
+/// This session's recovery file, once it keeps one (for the panic hook).
+static ACTIVE: OnceLock<PathBuf> = OnceLock::new();
+/// Set by the panic hook: the recovery file stays whatever exit follows.
+static CRASHED: AtomicBool = AtomicBool::new(false);
+/// Whether the hook has said so (panics that follow the first say nothing more).
+static TOLD: AtomicBool = AtomicBool::new(false);
+
+/// Makes a panic keep this session's recovery file and write why beside it (unless a
+/// reason is there already: rendering stopped first), and say so on standard error.
+pub fn install_panic_hook() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        CRASHED.store(true, Ordering::Relaxed);
+        if let Some(path) = ACTIVE.get()
+            && !TOLD.swap(true, Ordering::Relaxed)
+        {
+            let reason = path.with_file_name(REASON);
+            if !reason.exists() {
+                let _ = std::fs::write(&reason, panic_reason(info));
+            }
+            eprintln!(
+                "Focal stopped: {}; the view is saved in {}: the next start offers to restore it (or run `focal --restore`)",
+                std::fs::read_to_string(&reason).unwrap_or_default().trim(),
+                path.display()
+            );
+        }
+        default(info);
+    }));
+}
+
+/// What a panic says, as the reason a session stopped: the renderer's (wgpu, Bevy's
+/// renderer: a driver or device failure) or a crash at a place in Focal.
+fn panic_reason(info: &std::panic::PanicHookInfo) -> String {
+    let message = info
+        .payload()
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| info.payload().downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic".into());
+    let first = message.lines().next().unwrap_or_default().trim().to_string();
+    match info.location() {
+        Some(l) if ["wgpu", "bevy_render"].iter().any(|c| l.file().contains(c)) => format!("the renderer failed ({first})"),
+        Some(l) => format!("it crashed ({first}, at {}:{})", l.file(), l.line()),
+        None => format!("it crashed ({first})"),
+    }
+}
+
 /// What the last session left.
 pub struct Found {
     /// Where it was moved at start.
@@ -28,6 +88,8 @@ pub struct Found {
     pub scene: SceneFile,
     /// When it was written, as the user reads it ("4 min ago").
     pub age: String,
+    /// Why the session stopped, where Focal knew (a lost device).
+    pub reason: Option<String>,
 }
 
 /// The recovery file of this session, and the one the last session left.
@@ -42,6 +104,10 @@ pub struct Recovery {
     pub found: Option<Found>,
     /// Restore it at start without asking (`focal --restore`).
     pub restore_at_start: bool,
+    /// Kept through this exit (rendering stopped): the next start finds it.
+    keep: bool,
+    /// A write asked for at once that has not happened yet.
+    pending: bool,
 }
 
 impl Recovery {
@@ -59,6 +125,9 @@ impl Recovery {
         }
         let path = Recovery::file();
         let found = path.as_deref().and_then(take_previous);
+        if let Some(p) = &path {
+            let _ = ACTIVE.set(p.clone());
+        }
         Recovery { path, found, restore_at_start, ..Default::default() }
     }
 
@@ -68,6 +137,7 @@ impl Recovery {
             return;
         }
         self.next = Some(now + EVERY);
+        self.pending = false;
         let Some(path) = self.path.clone() else { return };
         let text = match text() {
             Ok(t) => t,
@@ -85,13 +155,35 @@ impl Recovery {
         }
     }
 
-    /// A clean exit: nothing to recover.
-    pub fn remove(&self) {
+    /// Rendering stopped (`why`): the view is written at the next chance, whether it
+    /// changed or not, and kept through the exit with the reason beside it.
+    pub fn keep_for_next_start(&mut self, why: &str) {
+        (self.keep, self.pending, self.next, self.last) = (true, true, None, None);
         if let Some(p) = &self.path
-            && let Err(e) = std::fs::remove_file(p)
-            && e.kind() != std::io::ErrorKind::NotFound
+            && let Err(e) = super::settings::write_atomically(&p.with_file_name(REASON), why)
         {
-            warn!("{}: {e}", p.display());
+            warn!("{e}");
+        }
+    }
+
+    /// Whether a write asked for at once ([`Self::keep_for_next_start`]) is still to come.
+    pub fn pending(&self) -> bool {
+        self.pending && self.path.is_some()
+    }
+
+    /// A clean exit: nothing to recover (after a panic, whatever exit follows keeps it).
+    pub fn remove(&self) {
+        if CRASHED.load(Ordering::Relaxed) {
+            return;
+        }
+        if let Some(p) = &self.path {
+            for p in [p.clone(), p.with_file_name(REASON)] {
+                if let Err(e) = std::fs::remove_file(&p)
+                    && e.kind() != std::io::ErrorKind::NotFound
+                {
+                    warn!("{}: {e}", p.display());
+                }
+            }
         }
     }
 
@@ -105,6 +197,7 @@ impl Recovery {
             warn!("{}: {e}", found.path.display());
         }
         info!("restored the last session's view from {}", found.path.display());
+        let _ = std::fs::remove_file(found.path.with_file_name(PREVIOUS_REASON));
         let base = found.path.parent().map(Path::to_path_buf).unwrap_or_default();
         Some(LoadRequest::Scene(Box::new(found.scene), base))
     }
@@ -113,6 +206,7 @@ impl Recovery {
     pub fn discard(&mut self) {
         if let Some(found) = self.found.take() {
             let _ = std::fs::remove_file(&found.path);
+            let _ = std::fs::remove_file(found.path.with_file_name(PREVIOUS_REASON));
         }
     }
 }
@@ -125,6 +219,11 @@ fn take_previous(path: &Path) -> Option<Found> {
         if let Err(e) = std::fs::rename(path, &previous) {
             warn!("{}: {e}", path.display());
             return None;
+        }
+        let reason = path.with_file_name(REASON);
+        match reason.is_file() {
+            true => _ = std::fs::rename(&reason, path.with_file_name(PREVIOUS_REASON)),
+            false => _ = std::fs::remove_file(path.with_file_name(PREVIOUS_REASON)),
         }
     } else if !previous.is_file() {
         return None;
@@ -140,7 +239,10 @@ fn take_previous(path: &Path) -> Option<Found> {
         })
         .unwrap_or_else(|| "at an unknown time".into());
     match crate::scene::read_scene(&previous) {
-        Ok(scene) => Some(Found { path: previous, scene, age }),
+        Ok(scene) => {
+            let reason = std::fs::read_to_string(previous.with_file_name(PREVIOUS_REASON)).ok().filter(|r| !r.trim().is_empty());
+            Some(Found { path: previous, scene, age, reason })
+        }
         Err(e) => {
             let bad = previous.with_extension("ron.bad");
             let _ = std::fs::rename(&previous, &bad);
@@ -164,6 +266,9 @@ pub fn offer(ctx: &egui::Context, recovery: &mut Recovery, load: &mut MessageWri
             "The last session did not end cleanly. Its view ({datasets} dataset(s), with their looks, lenses, windows, parts and rulers) was saved {}.",
             found.age
         ));
+        if let Some(reason) = &found.reason {
+            ui.label(egui::RichText::new(format!("It stopped because {}.", reason.trim())).color(egui::Color32::from_rgb(255, 160, 60)));
+        }
         ui.horizontal(|ui| {
             if ui.button("Restore").clicked() {
                 choice = Some(true);
@@ -184,9 +289,9 @@ pub fn offer(ctx: &egui::Context, recovery: &mut Recovery, load: &mut MessageWri
     }
 }
 
-/// Removes the recovery file when the app exits cleanly.
+/// Removes the recovery file when the app exits cleanly (not when rendering stopped).
 pub fn remove_on_exit(mut exits: MessageReader<AppExit>, recovery: Res<Recovery>) {
-    if exits.read().next().is_some() {
+    if exits.read().next().is_some() && !recovery.keep {
         recovery.remove();
     }
 }
@@ -237,5 +342,33 @@ mod tests {
         std::fs::write(&path, "(datasets: [(source: Nonsense)])").unwrap();
         assert!(take_previous(&path).is_none());
         assert!(dir.join("recovery-previous.ron.bad").exists());
+    }
+
+    /// Rendering stopped: the view is written at once (unchanged or not), kept through
+    /// the exit, and found at the next start with the reason.
+    #[test]
+    fn a_stopped_session_is_kept_with_its_reason() {
+        let dir = std::env::temp_dir().join(format!("focal-recovery-kept-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let path = dir.join("recovery.ron");
+        let mut r = Recovery { path: Some(path.clone()), ..Default::default() };
+        let t0 = Instant::now();
+        r.autosave(t0, || Ok("(datasets: [])".into()));
+        r.keep_for_next_start("the graphics device was lost (test)");
+        assert!(r.pending());
+        // At once, though EVERY has not passed and the text is the same.
+        r.autosave(t0 + EVERY / 10, || Ok("(datasets: [])".into()));
+        assert!(!r.pending());
+        assert!(r.keep, "the exit keeps it");
+        let found = take_previous(&path).unwrap();
+        assert_eq!(found.reason.as_deref(), Some("the graphics device was lost (test)"));
+        assert!(!dir.join(REASON).exists() && dir.join(PREVIOUS_REASON).exists());
+        let mut next = Recovery { path: Some(path.clone()), found: Some(found), ..Default::default() };
+        next.discard();
+        assert!(!dir.join(PREVIOUS_REASON).exists() && !dir.join("recovery-previous.ron").exists());
+        // A clean exit after an ordinary session leaves no reason behind either.
+        next.autosave(t0, || Ok("(x)".into()));
+        next.remove();
+        assert!(!path.exists() && !dir.join(REASON).exists());
     }
 }

@@ -14,7 +14,7 @@ use bevy_egui::{EguiContexts, egui};
 
 use super::state::MainCamera;
 use super::under_cursor::UnderCursor;
-use super::viewport::viewport_logical;
+use super::viewport::viewport_rect;
 use crate::streaming::bricked::{BrickedScene, StreamStatus};
 
 pub fn streaming_status(
@@ -51,13 +51,7 @@ pub fn streaming_status(
     }
     let color = if converged { egui::Color32::GRAY } else { egui::Color32::YELLOW };
     // The 3D viewport (beside the panels), in egui points.
-    let rect = match (windows.single(), cams.single()) {
-        (Ok(window), Ok(camera)) => {
-            let (origin, size) = viewport_logical(camera, window);
-            egui::Rect::from_min_size(egui::pos2(origin.x, origin.y), egui::vec2(size.x, size.y))
-        }
-        _ => ctx.viewport_rect(),
-    };
+    let rect = viewport_rect(&ctx, &windows, &cams);
     let margin = 8.0;
     egui::Area::new("streaming status".into())
         .pivot(egui::Align2::LEFT_BOTTOM)

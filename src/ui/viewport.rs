@@ -18,6 +18,22 @@ pub fn set_viewport(camera: &mut Camera, window: &Window, free: bevy_egui::egui:
     }
 }
 
+/// The main camera's viewport as an egui rectangle (window-logical points), or the
+/// whole of `ctx` without a window or camera: where overlays go.
+pub fn viewport_rect(
+    ctx: &bevy_egui::egui::Context,
+    windows: &Query<&Window, With<bevy::window::PrimaryWindow>>,
+    cams: &Query<&Camera, With<super::state::MainCamera>>,
+) -> bevy_egui::egui::Rect {
+    match (windows.single(), cams.single()) {
+        (Ok(window), Ok(camera)) => {
+            let (origin, size) = viewport_logical(camera, window);
+            bevy_egui::egui::Rect::from_min_size(bevy_egui::egui::pos2(origin.x, origin.y), bevy_egui::egui::vec2(size.x, size.y))
+        }
+        _ => ctx.viewport_rect(),
+    }
+}
+
 /// Window-logical origin and size of the main camera's viewport.
 pub fn viewport_logical(camera: &Camera, window: &Window) -> (Vec2, Vec2) {
     let scale = window.scale_factor();

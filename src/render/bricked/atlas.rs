@@ -59,6 +59,9 @@ pub struct BrickAtlas {
     pub coarse_in_atlas: bool,
     /// What the page buffer was last built from, where every drawn brick found its slot.
     built: Option<Built>,
+    /// The cache size the device refused (not asked for again; the main world halves
+    /// the budget).
+    refused: Option<UVec3>,
 }
 
 /// The frames a page buffer was built from: each bricked volume's place in the
@@ -109,7 +112,7 @@ pub fn upload_bricks(
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
     adapter: Res<RenderAdapter>,
-    status: Res<StreamStatus>,
+    (status, health): (Res<StreamStatus>, Res<crate::render::health::RenderHealth>),
     mut atlas: ResMut<BrickAtlas>,
 ) {
     let Some(extracted) = extracted else { return };
@@ -127,13 +130,37 @@ pub fn upload_bricks(
         _ => true,
     };
     if stale {
-        let slots = if want_slots {
-            Slots::new(edge, device.limits().max_texture_dimension_3d, extracted.budget.gpu_bytes, bpp)
-        } else {
-            Slots::new(1, 1, 1, 1)
+        let wanted = want_slots.then(|| Slots::new(edge, device.limits().max_texture_dimension_3d, extracted.budget.gpu_bytes, bpp));
+        // (A size the device refused: one slot, so the pass still binds an atlas and
+        // in-memory volumes are drawn, until the halved budget asks for less.)
+        let slots = match wanted {
+            Some(s) if atlas.refused != Some(s.texture_size()) => s,
+            _ => Slots::new(1, 1, 1, 1),
         };
-        let texture = device.create_texture(&sampled_3d("focal brick cache atlas", slots.texture_size(), format));
-        atlas.view = Some(texture.create_view(&TextureViewDescriptor::default()));
+        let size = slots.texture_size();
+        let made = crate::render::health::scoped(&device, || {
+            let texture = device.create_texture(&sampled_3d("focal brick cache atlas", size, format));
+            let view = texture.create_view(&TextureViewDescriptor::default());
+            (texture, view)
+        });
+        let (texture, view, slots) = match made {
+            Ok((texture, view)) => (texture, view, slots),
+            Err(reason) => {
+                let s = size.as_u64vec3();
+                health.refuse(crate::render::health::Refusal {
+                    what: crate::render::health::Refused::BrickCache,
+                    reason,
+                    largest_edge: size.max_element(),
+                    bytes: s.x * s.y * s.z * bpp as u64,
+                });
+                atlas.refused = Some(size);
+                let one = Slots::new(1, 1, 1, 1);
+                let texture = device.create_texture(&sampled_3d("focal brick cache atlas", one.texture_size(), format));
+                let view = texture.create_view(&TextureViewDescriptor::default());
+                (texture, view, one)
+            }
+        };
+        atlas.view = Some(view);
         atlas.texture = Some((texture, format));
         atlas.slots = Some(slots);
     }
