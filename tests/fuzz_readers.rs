@@ -374,11 +374,13 @@ fn scene_files() {
 
 #[test]
 fn ome_zarr_metadata_and_chunks() {
-    use focal::volume::convert::ome_zarr::{WriteOptions, ZarrVersion, write};
+    use focal::volume::convert::ome_zarr::{Compressor, WriteOptions, ZarrVersion, write};
     let volume = read_volume(&data("ct/fuel.nii.gz"), &ReadOptions::default()).unwrap();
     let mut failures = Vec::new();
     let stores = [
         ("v3 sharded", WriteOptions { chunk: 16, shard: Some(2), ..Default::default() }),
+        // (Blosc inside the shards: the guard walks a shard's index to check each frame.)
+        ("v3 sharded blosc", WriteOptions { chunk: 16, shard: Some(2), compressor: Compressor::Blosc, ..Default::default() }),
         ("v2", WriteOptions { chunk: 16, version: ZarrVersion::V2, ..Default::default() }),
     ];
     for (k, (what, opts)) in stores.into_iter().enumerate() {

@@ -175,6 +175,10 @@ fn converted_pyramids_pass_the_independent_check() {
     let shard = WriteOptions { chunk: 16, shard: Some(2), ..Default::default() };
     let Some(line) = convert_and_check(&data("ct/fuel.nii.gz"), &dir.join("fuel.ome.zarr"), &shard) else { return };
     assert!(line.contains("\"zarr_format\": 3") && line.contains("uint8"), "{line}");
+    // The same, blosc inside the shards (what most OME-Zarr writers use).
+    let blosc = WriteOptions { compressor: focal::volume::convert::ome_zarr::Compressor::Blosc, ..shard };
+    let line = convert_and_check(&data("ct/fuel.nii.gz"), &dir.join("fuel-blosc.ome.zarr"), &blosc).expect("oracle");
+    assert!(line.contains("\"zarr_format\": 3"), "{line}");
     // An MRI with odd dimensions (181 × 217 × 181), Zarr v2.
     let v2 = WriteOptions { chunk: 32, version: ZarrVersion::V2, ..Default::default() };
     let line = convert_and_check(&data("mri/ch2.nii.gz"), &dir.join("ch2.ome.zarr"), &v2).expect("oracle");

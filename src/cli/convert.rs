@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use clap::{Args, ValueEnum};
 use focal::volume::convert::Downsample;
-use focal::volume::convert::ome_zarr::{WriteOptions, ZarrVersion, write};
+use focal::volume::convert::ome_zarr::{Compressor, WriteOptions, ZarrVersion, write};
 use focal::volume::readers::{RawSpec, ReadOptions, read_volume};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -18,6 +18,14 @@ enum Version {
     /// Zarr v3 with OME-NGFF 0.5.
     #[value(name = "3")]
     V3,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Codec {
+    /// Zstandard.
+    Zstd,
+    /// Blosc with Zstandard inside and byte shuffle (what most OME-Zarr writers use).
+    Blosc,
 }
 
 #[derive(Args)]
@@ -35,6 +43,9 @@ pub struct ConvertArgs {
     /// Zarr format: 3 (OME-NGFF 0.5) or 2 (OME-NGFF 0.4).
     #[arg(long, value_enum, default_value = "3")]
     zarr: Version,
+    /// Compression of Zarr v3 chunks (Zarr v2's are blosc).
+    #[arg(long, value_enum, default_value = "zstd")]
+    codec: Codec,
     /// A label map: levels take the first voxel of each block instead of the mean.
     #[arg(long)]
     labels: bool,
@@ -58,6 +69,10 @@ pub fn run(args: &ConvertArgs) -> Result<(), String> {
         },
         downsample: if args.labels { Downsample::Nearest } else { Downsample::Mean },
         overwrite: args.force,
+        compressor: match args.codec {
+            Codec::Zstd => Compressor::Zstd,
+            Codec::Blosc => Compressor::Blosc,
+        },
     };
     let bar = ProgressBar::new(1);
     bar.set_style(

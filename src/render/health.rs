@@ -84,17 +84,20 @@ impl RenderHealth {
         self.with(|s| s.stopped.clone())
     }
 
-    fn stop(&self, why: String) {
+    /// Records why rendering stopped; whether this was the first reason.
+    fn stop(&self, why: String) -> bool {
         self.with(|s| {
+            let first = s.stopped.is_none();
             s.stopped.get_or_insert(why);
-        });
+            first
+        })
     }
 }
 
 impl Refusal {
     fn describe(&self) -> String {
         let what = match self.what {
-            Refused::Volumes => "the volume textures",
+            Refused::Volumes => "the volume textures and buffers",
             Refused::BrickCache => "the brick cache",
         };
         format!("{what} ({} MiB, {} texels along the longest edge)", self.bytes.div_ceil(1 << 20), self.largest_edge)
@@ -133,9 +136,9 @@ pub fn error_handler() -> RenderErrorHandler {
             ErrorType::OutOfMemory => "the graphics device ran out of memory".to_string(),
             _ => format!("the graphics device reported an error ({:?}: {})", error.ty, error.description),
         };
-        error!("rendering stopped: {why}");
-        if let Some(health) = main_world.get_resource::<RenderHealth>() {
-            health.stop(why);
+        // (Bevy asks again every frame after a stop: said once.)
+        if main_world.get_resource::<RenderHealth>().is_some_and(|h| h.stop(why.clone())) {
+            error!("rendering stopped: {why}");
         }
         RenderErrorPolicy::StopRendering
     })
@@ -174,9 +177,10 @@ pub fn lower_limits_after_refusals(
                     r.reason
                 ),
             },
-            Refused::BrickCache => match budget.as_deref_mut().filter(|b| b.gpu_bytes / 2 >= MIN_BYTES) {
+            Refused::BrickCache => match budget.as_deref_mut().filter(|b| b.gpu_bytes.min(r.bytes) / 2 >= MIN_BYTES) {
                 Some(b) => {
-                    b.gpu_bytes /= 2;
+                    // (Below what was refused: the cache may be smaller than the budget.)
+                    b.gpu_bytes = b.gpu_bytes.min(r.bytes) / 2;
                     format!("the GPU refused {} ({}): the brick cache is now {} MiB", r.describe(), r.reason, b.gpu_bytes >> 20)
                 }
                 None => format!("the GPU refused {} ({}): streamed volumes are not drawn", r.describe(), r.reason),

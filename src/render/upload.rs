@@ -50,8 +50,9 @@ pub struct GpuScene {
     pub bricked_directory: Vec<usize>,
     /// The coarse level of each bricked scene volume the packing saw.
     bricked_key: Vec<Option<usize>>,
-    /// The volumes (as `atlas_key`) of a scene the device refused to hold.
-    refused_key: Option<Vec<usize>>,
+    /// The volumes (as `atlas_key`) of a scene the device refused to hold, and the
+    /// limits it was packed under (lowered limits try it again, repacked).
+    refused_key: Option<(Vec<usize>, crate::dataset::gpu_fit::GpuLimits)>,
 }
 
 impl GpuScene {
@@ -110,7 +111,7 @@ pub fn upload_scene(
         .chain(seconds.clone().map(|s| s.map_or(0, |s| s as *const Volume as usize)))
         .collect();
     // (A scene the device refused waits for its volumes to change: fitted smaller.)
-    if gpu.refused_key.as_ref() == Some(&key) {
+    if gpu.refused_key.as_ref().is_some_and(|(k, l)| *k == key && *l == extracted.limits) {
         return;
     }
     let volumes: Vec<(&Volume, Option<&Volume>)> = packed.volumes.iter().map(|&v| all[v].as_ref()).zip(seconds).collect();
@@ -135,7 +136,7 @@ pub fn upload_scene(
                 bytes: size.x * size.y * size.z * texel_bytes(&volumes) as u64,
             });
             // Nothing of it is bound: the pass draws nothing until smaller volumes come.
-            *gpu = GpuScene { refused_key: Some(key), ..Default::default() };
+            *gpu = GpuScene { refused_key: Some((key, extracted.limits)), ..Default::default() };
             return;
         }
     }

@@ -46,6 +46,11 @@ static TOLD: AtomicBool = AtomicBool::new(false);
 pub fn install_panic_hook() {
     let default = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
+        // (A parser's panic on a corrupt file is caught and reported as its error.)
+        if crate::volume::caught::is_expected() {
+            default(info);
+            return;
+        }
         CRASHED.store(true, Ordering::Relaxed);
         if let Some(path) = ACTIVE.get()
             && !TOLD.swap(true, Ordering::Relaxed)
@@ -124,6 +129,10 @@ impl Recovery {
             return Recovery::default();
         }
         let path = Recovery::file();
+        // (A reason without a view beside it says nothing about the next stop.)
+        if let Some(p) = path.as_deref().filter(|p| !p.is_file()) {
+            let _ = std::fs::remove_file(p.with_file_name(REASON));
+        }
         let found = path.as_deref().and_then(take_previous);
         if let Some(p) = &path {
             let _ = ACTIVE.set(p.clone());

@@ -7,6 +7,7 @@
 //! volumes ([`SelectionVolume`], degree of interest 0..1) are volumes too.
 
 pub mod bricks;
+pub mod caught;
 pub mod convert;
 pub mod encode;
 pub mod grid;

@@ -124,18 +124,23 @@ pub fn upload_bricks(
     let want_slots = !frames.is_empty();
     atlas.idle_frames = if want_slots { 0 } else { atlas.idle_frames.saturating_add(1) };
     let release = atlas.idle_frames >= RELEASE_AFTER_FRAMES;
+    let wanted = || Slots::new(edge, device.limits().max_texture_dimension_3d, extracted.budget.gpu_bytes, bpp);
     let stale = match (&atlas.texture, &atlas.slots) {
-        (Some((_, f)), Some(s)) if want_slots => *f != format || s.edge != edge,
+        // (After a refusal, the halved budget's size is tried when it differs.)
+        (Some((_, f)), Some(s)) if want_slots => {
+            *f != format || s.edge != edge || atlas.refused.is_some_and(|r| r != wanted().texture_size())
+        }
         (Some(_), Some(s)) => release && s.len() > 1,
         _ => true,
     };
     if stale {
-        let wanted = want_slots.then(|| Slots::new(edge, device.limits().max_texture_dimension_3d, extracted.budget.gpu_bytes, bpp));
-        // (A size the device refused: one slot, so the pass still binds an atlas and
-        // in-memory volumes are drawn, until the halved budget asks for less.)
-        let slots = match wanted {
+        // (A size the device refused: one slot of the bricks' size, so the pass still
+        // binds an atlas, in-memory volumes are drawn and streamed ones coarser, until
+        // the halved budget asks for less.)
+        let slots = match want_slots.then(wanted) {
             Some(s) if atlas.refused != Some(s.texture_size()) => s,
-            _ => Slots::new(1, 1, 1, 1),
+            Some(_) => Slots::new(edge, edge, 0, bpp),
+            None => Slots::new(1, 1, 1, 1),
         };
         let size = slots.texture_size();
         let made = crate::render::health::scoped(&device, || {
@@ -144,7 +149,12 @@ pub fn upload_bricks(
             (texture, view)
         });
         let (texture, view, slots) = match made {
-            Ok((texture, view)) => (texture, view, slots),
+            Ok((texture, view)) => {
+                if slots.len() > 1 {
+                    atlas.refused = None;
+                }
+                (texture, view, slots)
+            }
             Err(reason) => {
                 let s = size.as_u64vec3();
                 health.refuse(crate::render::health::Refusal {
@@ -154,7 +164,7 @@ pub fn upload_bricks(
                     bytes: s.x * s.y * s.z * bpp as u64,
                 });
                 atlas.refused = Some(size);
-                let one = Slots::new(1, 1, 1, 1);
+                let one = Slots::new(edge, edge, 0, bpp);
                 let texture = device.create_texture(&sampled_3d("focal brick cache atlas", one.texture_size(), format));
                 let view = texture.create_view(&TextureViewDescriptor::default());
                 (texture, view, one)

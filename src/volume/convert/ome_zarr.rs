@@ -1,5 +1,6 @@
-//! Writing a volume as an OME-Zarr pyramid: NGFF 0.5 on Zarr v3 (zstd, optionally
-//! sharded) or NGFF 0.4 on Zarr v2 (blosc with zstd), arrays `0`, `1`, … in (z, y, x)
+//! Writing a volume as an OME-Zarr pyramid: NGFF 0.5 on Zarr v3 (zstd, or blosc with
+//! zstd inside, optionally sharded) or NGFF 0.4 on Zarr v2 (blosc with zstd), arrays
+//! `0`, `1`, … in (z, y, x)
 //! order, chunks written in parallel through `zarrs`.
 //!
 //! Each level's `coordinateTransformations` give its voxel size (`scale`, millimetres)
@@ -49,11 +50,30 @@ pub struct WriteOptions {
     pub downsample: Downsample,
     /// Replace an existing pyramid at the output path.
     pub overwrite: bool,
+    /// How Zarr v3 chunks are compressed (v2's are blosc).
+    pub compressor: Compressor,
+}
+
+/// Compression of Zarr v3 chunks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Compressor {
+    /// Zstandard, level 3.
+    #[default]
+    Zstd,
+    /// Blosc with Zstandard inside, level 5, byte shuffle (what most OME-Zarr writers use).
+    Blosc,
 }
 
 impl Default for WriteOptions {
     fn default() -> Self {
-        Self { chunk: 64, shard: None, version: ZarrVersion::V3, downsample: Downsample::Mean, overwrite: false }
+        Self {
+            chunk: 64,
+            shard: None,
+            version: ZarrVersion::V3,
+            downsample: Downsample::Mean,
+            overwrite: false,
+            compressor: Compressor::Zstd,
+        }
     }
 }
 
@@ -170,7 +190,7 @@ fn create_array(
             };
             let outer: Vec<u64> = chunk.iter().map(|c| c * opts.shard.unwrap_or(1) as u64).collect();
             let mut b = ArrayBuilder::new(zyx(dims), outer, dt, fill);
-            b.bytes_to_bytes_codecs(vec![Arc::new(ZstdCodec::new(3, false))]);
+            b.bytes_to_bytes_codecs(vec![compressor(opts.compressor, sample)?]);
             if opts.shard.is_some() {
                 b.subchunk_shape(chunk.clone());
             }
@@ -195,6 +215,26 @@ fn create_array(
     };
     array.store_metadata().map_err(|e| e.to_string())?;
     Ok(array)
+}
+
+/// The bytes-to-bytes codec of Zarr v3 chunks.
+fn compressor(c: Compressor, sample: SampleKind) -> Result<Arc<dyn zarrs::array::BytesToBytesCodecTraits>, String> {
+    use zarrs::array::codec::{BloscCodec, BloscCompressionLevel, BloscCompressor, BloscShuffleMode};
+    Ok(match c {
+        Compressor::Zstd => Arc::new(ZstdCodec::new(3, false)),
+        Compressor::Blosc => {
+            let typesize = match sample {
+                SampleKind::U8 => 1,
+                SampleKind::U16 | SampleKind::I16 => 2,
+                SampleKind::F32 => 4,
+            };
+            let level = BloscCompressionLevel::try_from(5u8).map_err(|l| format!("blosc level {l}"))?;
+            Arc::new(
+                BloscCodec::new(BloscCompressor::Zstd, level, None, BloscShuffleMode::Shuffle, Some(typesize))
+                    .map_err(|e| e.to_string())?,
+            )
+        }
+    })
 }
 
 /// Writes every storage chunk of one level, in parallel.

@@ -144,12 +144,14 @@ pub fn read_volume(path: &Path, options: &ReadOptions) -> Result<Volume, ReadErr
 
 /// Reads a label volume and its table: `table` if given, else the sidecar files found
 /// beside the volume (`NAME.txt`, `NAME.lut`, `NAME.csv` for `NAME.nii.gz` and the
-/// like); ids without an entry get generated colours.
+/// like), else the one the file carries (a DICOM segmentation's); ids without an entry
+/// get generated colours.
 pub fn read_label_volume(path: &Path, table: Option<&Path>, options: &ReadOptions) -> Result<LabelVolume, ReadError> {
-    let volume = read_volume(path, options)?;
+    let mut volume = read_volume(path, options)?;
+    let carried = volume.label_table.take();
     let table = match table {
         Some(t) => label_table::read(t)?,
-        None => label_table::read_sidecars(path)?,
+        None => Some(label_table::read_sidecars(path)?).filter(|t| !t.is_empty()).or(carried).unwrap_or_default(),
     };
     LabelVolume::from_volume(volume, table).map_err(|e| ReadError::new(path, Problem::Values(e)))
 }

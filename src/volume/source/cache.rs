@@ -220,8 +220,7 @@ impl BrickCache {
             let pinned = info.levels.len() - 1;
             (self.spawner)(Box::new(move || {
                 // A panicking read must neither abort the pool nor leave the key pending.
-                let read =
-                    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| layout.read(source.as_ref(), k.level as usize, k.coords())));
+                let read = crate::volume::caught::caught(|| layout.read(source.as_ref(), k.level as usize, k.coords()));
                 let result = read.unwrap_or_else(|_| {
                     Err(SourceError::new(source.info().location(), format!("reading brick {:?} of level {} panicked", k.brick, k.level)))
                 });

@@ -26,12 +26,12 @@ pub fn open(path: &Path, options: &ReadOptions) -> Result<DefaultDicomObject, Re
     }
     let bytes = std::fs::read(path).map_err(|e| fail(Problem::Io(e)))?;
     options.count_whole(len);
-    guard::check(&bytes).map_err(fail)?;
+    guard::check(&bytes, options.max_bytes + (64 << 20)).map_err(fail)?;
     let (start, _) = guard::meta_start(&bytes).map_err(fail)?;
     let from = &bytes[start - 4..];
     // The guard bounds every allocation; a parser panic on some other inconsistency is
     // still turned into an error rather than taking the application down.
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| OpenFileOptions::new().read_preamble(ReadPreamble::Never).from_reader(from)))
+    crate::volume::caught::caught(|| OpenFileOptions::new().read_preamble(ReadPreamble::Never).from_reader(from))
         .map_err(|_| fail(Problem::Malformed("the DICOM parser failed on this file".into())))?
         .map_err(|e| fail(Problem::Malformed(format!("DICOM parser: {e}"))))
 }
@@ -206,7 +206,7 @@ pub(super) fn pixel_bytes<'a>(object: &'a DefaultDicomObject, format: &PixelForm
         Err(_) => {
             // Encapsulated (compressed) pixel data: let dicom-pixeldata decode it.
             use dicom_pixeldata::PixelDecoder;
-            let decoded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| object.decode_pixel_data()))
+            let decoded = crate::volume::caught::caught(|| object.decode_pixel_data())
                 .map_err(|_| Problem::Corrupt("the pixel data decoder failed on this data".into()))?
                 .map_err(|e| Problem::Unsupported(format!("pixel data in transfer syntax {}: {}", transfer_syntax(object), chain(&e))))?;
             Cow::Owned(decoded.data().to_vec())

@@ -14,7 +14,7 @@
 //! length (sequences, items, encapsulated pixel data), closed by a delimiter. The file
 //! meta group is always explicit VR little endian. In the deflated transfer syntax
 //! (1.2.840.10008.1.2.1.99, PS3.5 §A.5) the data set after it is a raw deflate stream
-//! of explicit VR little endian: it is inflated (at most [`MAX_INFLATED`] bytes) and
+//! of explicit VR little endian: it is inflated (at most the reader's byte limit) and
 //! walked so.
 
 use super::super::common::Problem;
@@ -26,9 +26,6 @@ const UNDEFINED: u32 = 0xFFFF_FFFF;
 
 /// The Pixel Data element.
 const PIXEL_DATA: Tag = (0x7FE0, 0x0010);
-
-/// Most bytes a deflated data set may inflate to (the parser holds it whole).
-pub const MAX_INFLATED: u64 = 4 << 30;
 
 /// The deflated explicit VR little endian transfer syntax.
 const DEFLATED: &str = "1.2.840.10008.1.2.1.99";
@@ -60,8 +57,9 @@ struct Header {
     value_at: usize,
 }
 
-/// Checks the whole file; returns the transfer syntax UID.
-pub fn check(bytes: &[u8]) -> Result<String, Problem> {
+/// Checks the whole file (a deflated data set inflating to at most `max_inflated`
+/// bytes); returns the transfer syntax UID.
+pub fn check(bytes: &[u8], max_inflated: u64) -> Result<String, Problem> {
     let (start, _) = meta_start(bytes)?;
     let meta = Encoding { explicit: true, big_endian: false };
     let mut w = Walker { bytes, pos: start, enc: meta, fragments: false };
@@ -83,7 +81,7 @@ pub fn check(bytes: &[u8]) -> Result<String, Problem> {
         _ => Encoding { explicit: true, big_endian: false },
     };
     if ts == DEFLATED {
-        let inflated = inflate(&bytes[w.pos..], MAX_INFLATED)?;
+        let inflated = inflate(&bytes[w.pos..], max_inflated)?;
         Walker { bytes: &inflated, pos: 0, enc: w.enc, fragments: false }.walk(inflated.len(), 0)?;
     } else {
         w.walk(bytes.len(), 0)?;
@@ -215,7 +213,7 @@ impl Walker<'_> {
                     let inside = if tag == (0xFFFE, 0xE000) {
                         !self.fragments
                     } else {
-                        vr == Some(*b"SQ") || (vr.is_none() && self.starts_with_item(value_at, len))
+                        vr == Some(*b"SQ") || (vr.is_none() && tag != PIXEL_DATA && self.starts_with_item(value_at, len))
                     };
                     if inside {
                         let outer_fragments = std::mem::replace(&mut self.fragments, false);
@@ -269,12 +267,12 @@ mod tests {
     #[test]
     fn accepts_consistent_and_refuses_overlong_lengths() {
         let good = file("1.2.840.10008.1.2.1", &element_explicit(0x0010, 0x0010, b"PN", b"DOE^J "));
-        assert_eq!(check(&good).unwrap(), "1.2.840.10008.1.2.1");
+        assert_eq!(check(&good, 1 << 20).unwrap(), "1.2.840.10008.1.2.1");
         let mut bad = file("1.2.840.10008.1.2.1", &element_explicit(0x7FE0, 0x0010, b"OW", &[0u8; 16]));
         let n = bad.len();
         bad[n - 20..n - 16].copy_from_slice(&0xFFFF_FFF0u32.to_le_bytes());
-        assert!(matches!(check(&bad), Err(Problem::Truncated(_))), "{:?}", check(&bad));
-        assert!(matches!(check(&[0u8; 64]), Err(Problem::NotFormat { .. })));
+        assert!(matches!(check(&bad, 1 << 20), Err(Problem::Truncated(_))), "{:?}", check(&bad, 1 << 20));
+        assert!(matches!(check(&[0u8; 64], 1 << 20), Err(Problem::NotFormat { .. })));
     }
 
     #[test]
@@ -287,7 +285,7 @@ mod tests {
             body.extend_from_slice(&UNDEFINED.to_le_bytes());
         }
         let f = file("1.2.840.10008.1.2", &body);
-        assert!(matches!(check(&f), Err(Problem::Malformed(_))));
+        assert!(matches!(check(&f, 1 << 20), Err(Problem::Malformed(_))));
     }
 
     #[test]
@@ -299,13 +297,13 @@ mod tests {
             e.finish().unwrap()
         };
         let name = element_explicit(0x0010, 0x0010, b"PN", b"DOE^J ");
-        assert_eq!(check(&file(DEFLATED, &deflate(&name))).unwrap(), DEFLATED);
+        assert_eq!(check(&file(DEFLATED, &deflate(&name)), 1 << 20).unwrap(), DEFLATED);
         // An overlong length inside the deflated set is found as in a plain one.
         let mut overlong = element_explicit(0x7FE0, 0x0010, b"OW", &[0u8; 16]);
         overlong[8..12].copy_from_slice(&0xFFFF_FFF0u32.to_le_bytes());
-        assert!(matches!(check(&file(DEFLATED, &deflate(&overlong))), Err(Problem::Truncated(_))));
+        assert!(matches!(check(&file(DEFLATED, &deflate(&overlong)), 1 << 20), Err(Problem::Truncated(_))));
         // Not a deflate stream; one that inflates past the limit.
-        assert!(matches!(check(&file(DEFLATED, &[0xFF; 40])), Err(Problem::Corrupt(_))));
+        assert!(matches!(check(&file(DEFLATED, &[0xFF; 40]), 1 << 20), Err(Problem::Corrupt(_))));
         assert!(matches!(inflate(&deflate(&[0u8; 5000]), 4096), Err(Problem::TooLarge(_))));
         assert_eq!(inflate(&deflate(&[7u8; 4096]), 4096).unwrap(), vec![7u8; 4096]);
     }
@@ -324,12 +322,16 @@ mod tests {
         let mut bad_vr = element_explicit(0x0018, 0x0050, b"DS", b"2.5 ");
         bad_vr[4] = b'9';
         let sequence = element_explicit(0x0028, 0x9110, b"SQ", &item(&bad_vr));
-        assert!(matches!(check(&file("1.2.840.10008.1.2.1", &sequence)), Err(Problem::Malformed(_))));
+        assert!(matches!(check(&file("1.2.840.10008.1.2.1", &sequence), 1 << 20), Err(Problem::Malformed(_))));
         // Encapsulated pixel data: an empty offset table, then a fragment of any bytes.
         let mut pixels = vec![0xE0, 0x7F, 0x10, 0x00, b'O', b'B', 0, 0, 0xFF, 0xFF, 0xFF, 0xFF];
         pixels.extend(item(&[]));
         pixels.extend(item(&bad_vr));
         pixels.extend_from_slice(&[0xFE, 0xFF, 0xDD, 0xE0, 0, 0, 0, 0]);
-        assert!(check(&file("1.2.840.10008.1.2.4.50", &pixels)).is_ok(), "{:?}", check(&file("1.2.840.10008.1.2.4.50", &pixels)));
+        assert!(
+            check(&file("1.2.840.10008.1.2.4.50", &pixels), 1 << 20).is_ok(),
+            "{:?}",
+            check(&file("1.2.840.10008.1.2.4.50", &pixels), 1 << 20)
+        );
     }
 }

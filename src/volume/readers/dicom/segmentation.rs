@@ -25,7 +25,7 @@ use glam::Vec3;
 
 use super::file::{PixelFormat, float, floats, group_value, int, string};
 use super::series::{Plane, assemble, frame_geometry};
-use crate::volume::readers::common::{Problem, ReadError, ReadOptions, volume_name};
+use crate::volume::readers::common::{MAX_AXIS, Problem, ReadError, ReadOptions, volume_name};
 use crate::volume::{Label, LabelTable, Volume};
 
 /// SOP Class UID of Segmentation Storage.
@@ -81,15 +81,18 @@ pub fn read(path: &Path, object: DefaultDicomObject, options: &ReadOptions) -> R
         .or_else(|| float(&object, tags::SPACING_BETWEEN_SLICES))
         .filter(|s| s.is_finite() && *s > 0.0)
         .map(|s| s as f32);
+    // (One position for every frame, a 1-bit image's own: stacked as without positions.)
+    let positions = positions.filter(|p| p.iter().any(|q| (*q - p[0]).length() > 1e-3) || p.len() == 1);
     let (slice_of, origin, step): (Vec<usize>, Vec3, f32) = match positions {
         Some(p) => {
             let d: Vec<f32> = p.iter().map(|p| p.dot(normal)).collect();
-            let (k, first, step) = slice_indices(&d, step_given).map_err(fail)?;
+            let (k, first, step, note) = slice_indices(&d, step_given).map_err(fail)?;
+            notes.extend(note);
             (k, p[first], step)
         }
         None => {
             // (No positions: one slice a segment's frame, in frame order per segment.)
-            notes.push("frames have no Plane Position: each segment's frames stacked in order".into());
+            notes.push("frames have no positions of their own: each segment's frames stacked in order".into());
             let mut seen = std::collections::BTreeMap::<u32, usize>::new();
             let k = placed
                 .iter()
@@ -199,25 +202,35 @@ fn segments(o: &InMemDicomObject) -> (LabelTable, Vec<u32>) {
     (table, numbers)
 }
 
-/// The slice index of each distance along the normal, the index of a frame on slice 0
-/// and the step: `step` if given, else the smallest gap between distinct distances.
-fn slice_indices(d: &[f32], step: Option<f32>) -> Result<(Vec<usize>, usize, f32), Problem> {
+/// The slice index of each distance along the normal, the index of a frame on slice 0,
+/// the step and a note where the given step did not fit: `step` if given and every
+/// frame falls on its grid, else the smallest gap between distinct distances.
+fn slice_indices(d: &[f32], step: Option<f32>) -> Result<(Vec<usize>, usize, f32, Option<String>), Problem> {
     let (first, lo) = d.iter().copied().enumerate().fold((0, f32::INFINITY), |(i, lo), (j, x)| if x < lo { (j, x) } else { (i, lo) });
     let mut distinct: Vec<f32> = d.to_vec();
     distinct.sort_by(f32::total_cmp);
     distinct.dedup_by(|b, a| (*b - *a).abs() < 1e-3);
     let gap = distinct.windows(2).map(|w| w[1] - w[0]).fold(f32::INFINITY, f32::min);
-    let step = step.unwrap_or(if gap.is_finite() { gap } else { 1.0 });
-    let k: Vec<usize> = d.iter().map(|x| ((x - lo) / step).round() as usize).collect();
-    // (A step far below the frames' spread would make an absurd number of slices: the
-    // caller's size check refuses it; frames off the grid are a malformed file.)
-    if let Some((x, kx)) = d.iter().zip(&k).find(|(x, kx)| ((*x - lo) - **kx as f32 * step).abs() > 0.1 * step) {
-        return Err(Problem::Malformed(format!(
-            "a frame at {:.3} mm along the normal is off the slice grid of step {step:.3} mm (slice {kx})",
-            x - lo
-        )));
+    let gap = if gap.is_finite() { gap } else { 1.0 };
+    // Each frame's slice on the grid of `step`, unless one is off it or beyond an axis.
+    let on_grid = |step: f32| -> Option<Vec<usize>> {
+        d.iter()
+            .map(|x| {
+                let k = ((x - lo) / step).round();
+                let fits = k <= MAX_AXIS as f32 && ((x - lo) - k * step).abs() <= 0.1 * step;
+                fits.then_some(k as usize)
+            })
+            .collect()
+    };
+    if let Some(k) = step.and_then(on_grid) {
+        return Ok((k, first, step.unwrap_or(gap), None));
     }
-    Ok((k, first, step))
+    let k = on_grid(gap).ok_or_else(|| {
+        Problem::Malformed(format!("the frames' positions along the normal lie on no regular grid (smallest gap {gap:.3} mm)"))
+    })?;
+    let note =
+        step.map(|s| format!("Spacing Between Slices {s} mm does not fit the frames' positions: {gap:.3} mm, their smallest gap, is used"));
+    Ok((k, first, gap, note))
 }
 
 /// A DICOM Recommended Display CIELab Value (PS3.3 §C.10.7.1.1: L*, a*, b* scaled to
@@ -268,12 +281,19 @@ mod tests {
     #[test]
     fn frames_fall_on_slices_of_the_grid_and_gaps_stay_empty() {
         // Distances 10, 14, 12, 20 with step 2: slices 0, 2, 1, 5 (3 and 4 empty).
-        let (k, first, step) = slice_indices(&[10.0, 14.0, 12.0, 20.0], None).unwrap();
-        assert_eq!((k, first, step), (vec![0, 2, 1, 5], 0, 2.0));
+        let (k, first, step, note) = slice_indices(&[10.0, 14.0, 12.0, 20.0], None).unwrap();
+        assert_eq!((k, first, step, note), (vec![0, 2, 1, 5], 0, 2.0, None));
         // Two segments on one slice; the given step wins over the gaps.
-        let (k, first, step) = slice_indices(&[-3.0, -3.0, 3.0], Some(1.5)).unwrap();
-        assert_eq!((k, first, step), (vec![0, 0, 4], 0, 1.5));
-        // A frame between slices of the given step.
-        assert!(matches!(slice_indices(&[0.0, 1.0, 2.5], Some(1.0)), Err(Problem::Malformed(_))));
+        let (k, first, step, note) = slice_indices(&[-3.0, -3.0, 3.0], Some(1.5)).unwrap();
+        assert_eq!((k, first, step, note), (vec![0, 0, 4], 0, 1.5, None));
+        // A given step the frames do not fit (one between its slices, or a step so small
+        // the slices would run past an axis): their smallest gap, with a note.
+        let (k, _, step, note) = slice_indices(&[0.0, 1.0, 2.0], Some(0.8)).unwrap();
+        assert_eq!((k, step), (vec![0, 1, 2], 1.0));
+        assert!(note.is_some_and(|n| n.contains("0.8 mm does not fit")));
+        let (k, _, step, _) = slice_indices(&[0.0, 1.0], Some(f32::MIN_POSITIVE)).unwrap();
+        assert_eq!((k, step), (vec![0, 1], 1.0));
+        // Positions on no grid at all.
+        assert!(matches!(slice_indices(&[0.0, 1.0, 2.5], None), Err(Problem::Malformed(_))));
     }
 }

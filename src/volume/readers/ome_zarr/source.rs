@@ -69,6 +69,17 @@ struct Level {
     read_chunk: Vec<u64>,
 }
 
+/// Where a sharded array's index lies (at the end unless `index_location` says
+/// `start`) and whether it carries a CRC32C, from its `sharding_indexed` codec.
+fn shard_index(metadata: &serde_json::Value) -> Option<(bool, bool)> {
+    let codecs = metadata.get("codecs")?.as_array()?;
+    let sharding = codecs.iter().find(|c| c.get("name").and_then(|n| n.as_str()) == Some("sharding_indexed"))?;
+    let config = sharding.get("configuration")?;
+    let at_end = config.get("index_location").and_then(|l| l.as_str()) != Some("start");
+    let checksum = config.get("index_codecs").is_some_and(|c| c.to_string().contains("\"crc32c\""));
+    Some((at_end, checksum))
+}
+
 /// An opened OME-Zarr image.
 pub struct ZarrSource {
     info: SourceInfo,
@@ -78,19 +89,30 @@ pub struct ZarrSource {
 }
 
 impl ZarrSource {
-    /// The key prefix and the largest decoded chunk in bytes (its shape times 8, the
-    /// widest sample type) of each level whose codecs include blosc ([`super::guard`]).
-    pub fn blosc_arrays(&self) -> Vec<(String, u64)> {
+    /// The key prefix and the limit of each level whose codecs include blosc
+    /// ([`super::guard`]): the largest decoded chunk in bytes (the inner chunk's shape,
+    /// where sharded, times 8, the widest sample type) and the shard index's layout.
+    pub fn blosc_arrays(&self) -> Vec<(String, super::guard::Limit)> {
         self.levels
             .iter()
-            .filter(|l| serde_json::to_string(l.array.metadata()).is_ok_and(|m| m.contains("\"blosc\"")))
             .filter_map(|l| {
-                let shape = l.array.chunk_shape(&vec![0; l.fixed.len()]).ok()?;
-                let elements = shape.iter().map(|c| c.get()).fold(1u64, u64::saturating_mul);
+                let metadata = serde_json::to_value(l.array.metadata()).ok()?;
+                if !metadata.to_string().contains("\"blosc\"") {
+                    return None;
+                }
+                let zero = vec![0; l.fixed.len()];
+                let outer = l.array.chunk_shape(&zero).ok()?;
+                let inner = l.array.effective_subchunk_shape().unwrap_or_else(|| outer.clone());
+                let elements = |s: &[std::num::NonZeroU64]| s.iter().map(|c| c.get()).fold(1u64, u64::saturating_mul);
+                let shard = shard_index(&metadata).map(|(at_end, checksum)| super::guard::ShardIndex {
+                    chunks: outer.iter().zip(&inner).map(|(o, i)| o.get().div_ceil(i.get())).fold(1u64, u64::saturating_mul),
+                    at_end,
+                    checksum,
+                });
                 // (An array at the store's root: every key.)
                 let path = l.array.path().as_str().trim_matches('/');
                 let prefix = if path.is_empty() { String::new() } else { format!("{path}/") };
-                Some((prefix, elements.saturating_mul(8)))
+                Some((prefix, super::guard::Limit { chunk: elements(&inner).saturating_mul(8), shard }))
             })
             .collect()
     }
