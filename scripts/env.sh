@@ -8,7 +8,7 @@ export CARGO_TERM_COLOR="${CARGO_TERM_COLOR:-never}"
 # Debian packages: software Vulkan (lavapipe) for GPU rendering where there is no GPU,
 # a virtual X server for the app's window test, and OpenSSL's headers for the HTTP
 # store of OME-Zarr pyramids (reqwest's TLS).
-FOCAL_PACKAGES=(mesa-vulkan-drivers xvfb xauth libssl-dev pkg-config)
+FOCAL_PACKAGES=(mesa-vulkan-drivers xvfb xauth libssl-dev pkg-config cmake g++)
 
 ensure_packages() {
   local missing=()

@@ -311,15 +311,15 @@ fn dicom() {
     fuzz("dicom/enhanced_mr_multiframe.dcm", 8, 60);
     // pydicom's RT Dose grids: big-endian 32-bit, and RLE-coded (Focal's own RLE decoder
     // for 32-bit samples); its deflated data set (inflated by the guard, then the parser)
-    // and a JPEG 2000 image (openjp2).
+    // and JPEG 2000 and JPEG-LS images (openjp2, CharLS).
     let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pydicom");
-    for (k, name) in ["rtdose_expb", "rtdose_rle", "image_dfl", "JPEG2000"].iter().enumerate() {
+    for (k, name) in ["rtdose_expb", "rtdose_rle", "image_dfl", "JPEG2000", "MR_small_jpeg_ls_lossless"].iter().enumerate() {
         let bytes = std::fs::read(fixtures.join(name).join(format!("{name}.dcm"))).unwrap();
         fuzz_file(name, &bytes, &format!("{name}.dcm"), Reader::Volume, 40 + k as u64, 60);
     }
     // A 1-bit segmentation (packed frames, per-frame segments and positions).
     let seg = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/dicom_seg/seg_binary/seg_binary.dcm");
-    fuzz_file("seg_binary", &std::fs::read(seg).unwrap(), "seg_binary.dcm", Reader::Volume, 44, 80);
+    fuzz_file("seg_binary", &std::fs::read(seg).unwrap(), "seg_binary.dcm", Reader::Volume, 45, 80);
 }
 
 #[test]

@@ -289,9 +289,23 @@ fn screenshot_path() -> PathBuf {
     dir.join(format!("screenshot-{stamp}.png"))
 }
 
+/// Frames a reframe waits for the panels to give the 3D view its part of the window.
+const REFRAME_WAIT_FRAMES: u32 = 30;
+
 /// Places the camera on newly loaded data: a scene's own camera, else an oblique view.
-fn reframe(mut session: ResMut<Session>, mut cams: Query<(&mut OrbitCamera, &Camera), With<MainCamera>>) {
+/// (Framing depends on the view's aspect: it waits until the panels have set the
+/// viewport, else a load that finished before the first panel pass framed the data for
+/// the whole window, closer than for the view beside the panels.)
+fn reframe(mut session: ResMut<Session>, mut cams: Query<(&mut OrbitCamera, &Camera), With<MainCamera>>, mut waited: Local<u32>) {
     let Ok((mut orbit, camera)) = cams.single_mut() else { return };
+    if session.reframe.is_none() {
+        return;
+    }
+    if camera.viewport.is_none() && *waited < REFRAME_WAIT_FRAMES {
+        *waited += 1;
+        return;
+    }
+    *waited = 0;
     let Some(Reframe { bounds: (lo, hi), camera: spec }) = session.reframe.take() else { return };
     let aspect = camera.physical_viewport_size().map_or(1.0, |s| s.x as f32 / s.y.max(1) as f32);
     match spec {

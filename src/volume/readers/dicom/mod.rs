@@ -15,8 +15,8 @@
 //!   extended when Pixel Representation is 1; Rescale Slope/Intercept give real values
 //!   (Hounsfield units for CT). Positions are LPS and are flipped into Focal's RAS world.
 //! - Compressed transfer syntaxes (JPEG baseline and 8-bit extended, JPEG lossless, JPEG
-//!   2000 through the pure-Rust `openjp2`, RLE) are decoded by `dicom-pixeldata` (32-bit
-//!   RLE by [`rle`]); a decoder panic on bad
+//!   2000 through the pure-Rust `openjp2`, JPEG-LS through CharLS, RLE) are decoded by
+//!   `dicom-pixeldata` (32-bit RLE by [`rle`]); a decoder panic on bad
 //!   data is caught and reported, and a transfer syntax without a decoder is named.
 //!   Deflated data sets are inflated by the parser (and bounded by the guard first).
 //! - Segmentations and other 1-bit images are label volumes ([`segmentation`]).
