@@ -6,8 +6,9 @@ export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/focal-target}"
 export CARGO_TERM_COLOR="${CARGO_TERM_COLOR:-never}"
 
 # Debian packages: software Vulkan (lavapipe) for GPU rendering where there is no GPU,
-# a virtual X server for the app's window test, and OpenSSL's headers for the HTTP
-# store of OME-Zarr pyramids (reqwest's TLS).
+# a virtual X server for the app's window test, OpenSSL's headers for the HTTP store of
+# OME-Zarr pyramids (reqwest's TLS), and cmake with a C++ compiler for CharLS (the
+# JPEG-LS decoder of DICOM files).
 FOCAL_PACKAGES=(mesa-vulkan-drivers xvfb xauth libssl-dev pkg-config cmake g++)
 
 ensure_packages() {
