@@ -24,6 +24,12 @@ const MAX_DEPTH: usize = 24;
 
 const UNDEFINED: u32 = 0xFFFF_FFFF;
 
+/// The value representations of PS3.5 §6.2.
+const KNOWN_VRS: [[u8; 2]; 34] = [
+    *b"AE", *b"AS", *b"AT", *b"CS", *b"DA", *b"DS", *b"DT", *b"FD", *b"FL", *b"IS", *b"LO", *b"LT", *b"OB", *b"OD", *b"OF", *b"OL", *b"OV",
+    *b"OW", *b"PN", *b"SH", *b"SL", *b"SQ", *b"SS", *b"ST", *b"SV", *b"TM", *b"UC", *b"UI", *b"UL", *b"UN", *b"UR", *b"US", *b"UT", *b"UV",
+];
+
 /// The Pixel Data element.
 const PIXEL_DATA: Tag = (0x7FE0, 0x0010);
 
@@ -154,8 +160,15 @@ impl Walker<'_> {
             (None, self.u32_at(p + 4), p + 8)
         } else if self.enc.explicit {
             let vr = [self.bytes[p + 4], self.bytes[p + 5]];
-            if !vr.iter().all(u8::is_ascii_uppercase) {
-                return Err(Problem::Malformed(format!("element ({:04X},{:04X}) has an invalid VR at byte {p}", tag.0, tag.1)));
+            // (An unknown VR is read by the parser with a 4-byte length: a corrupted one
+            // made it allocate 1.4 GB.)
+            if !KNOWN_VRS.contains(&vr) {
+                return Err(Problem::Malformed(format!(
+                    "element ({:04X},{:04X}) has an unknown VR '{}' at byte {p}",
+                    tag.0,
+                    tag.1,
+                    String::from_utf8_lossy(&vr)
+                )));
             }
             if matches!(&vr, b"OB" | b"OD" | b"OF" | b"OL" | b"OV" | b"OW" | b"SQ" | b"SV" | b"UC" | b"UN" | b"UR" | b"UT" | b"UV") {
                 self.need(p, 12)?;
