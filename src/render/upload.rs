@@ -234,10 +234,17 @@ fn atlases(
     GpuAtlases { volumes: vv, bricks: bv, _textures: (vt, bt) }
 }
 
-/// Bytes of one texel of the volume atlas ([`volume_texels`]'s format).
-fn texel_bytes(volumes: &[(&Volume, Option<&Volume>)]) -> usize {
+/// The volume atlas's channels (2 where a volume carries a second one) and whether its
+/// texels are 16-bit (any volume is).
+fn atlas_layout(volumes: &[(&Volume, Option<&Volume>)]) -> (usize, bool) {
     let channels = if volumes.iter().any(|(_, s)| s.is_some()) { 2 } else { 1 };
     let sixteen = volumes.iter().flat_map(|(v, s)| std::iter::once(*v).chain(*s)).any(|v| v.voxels.bits() == 16);
+    (channels, sixteen)
+}
+
+/// Bytes of one texel of the volume atlas ([`volume_texels`]'s format).
+fn texel_bytes(volumes: &[(&Volume, Option<&Volume>)]) -> usize {
+    let (channels, sixteen) = atlas_layout(volumes);
     channels * if sixteen { 2 } else { 1 }
 }
 
@@ -245,9 +252,7 @@ fn texel_bytes(volumes: &[(&Volume, Option<&Volume>)]) -> usize {
 fn volume_texels(volumes: &[(&Volume, Option<&Volume>)], packed: &PackedScene, formats16: [TextureFormat; 2]) -> (TextureFormat, Vec<u8>) {
     let size = packed.atlas.size;
     let texels = (size.x * size.y * size.z) as usize;
-    let channels = if volumes.iter().any(|(_, s)| s.is_some()) { 2 } else { 1 };
-    let all = volumes.iter().flat_map(|(v, s)| std::iter::once(*v).chain(*s));
-    let sixteen = all.clone().any(|v| v.voxels.bits() == 16);
+    let (channels, sixteen) = atlas_layout(volumes);
     let (format, bytes) = match (sixteen, channels) {
         (false, 1) => (TextureFormat::R8Unorm, 1),
         (false, _) => (TextureFormat::Rg8Unorm, 2),

@@ -143,11 +143,12 @@ pub fn upload_bricks(
             None => Slots::new(1, 1, 1, 1),
         };
         let size = slots.texture_size();
-        let made = crate::render::health::scoped(&device, || {
+        let make = |size: UVec3| {
             let texture = device.create_texture(&sampled_3d("focal brick cache atlas", size, format));
             let view = texture.create_view(&TextureViewDescriptor::default());
             (texture, view)
-        });
+        };
+        let made = crate::render::health::scoped(&device, || make(size));
         let (texture, view, slots) = match made {
             Ok((texture, view)) => {
                 if slots.len() > 1 {
@@ -165,8 +166,7 @@ pub fn upload_bricks(
                 });
                 atlas.refused = Some(size);
                 let one = Slots::new(edge, edge, 0, bpp);
-                let texture = device.create_texture(&sampled_3d("focal brick cache atlas", one.texture_size(), format));
-                let view = texture.create_view(&TextureViewDescriptor::default());
+                let (texture, view) = make(one.texture_size());
                 (texture, view, one)
             }
         };

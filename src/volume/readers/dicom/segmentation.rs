@@ -188,8 +188,7 @@ impl<'a> Masks<'a> {
 fn segments(o: &InMemDicomObject) -> (LabelTable, Vec<u32>) {
     let mut table = LabelTable::default();
     let mut numbers = Vec::new();
-    let items = o.get(tags::SEGMENT_SEQUENCE).and_then(|e| e.items()).map(|v| v.to_vec()).unwrap_or_default();
-    for item in &items {
+    for item in o.get(tags::SEGMENT_SEQUENCE).and_then(|e| e.items()).into_iter().flatten() {
         let Some(number) = int(item, tags::SEGMENT_NUMBER).filter(|n| (1..=65535).contains(n)) else { continue };
         numbers.push(number);
         let name = string(item, tags::SEGMENT_LABEL).unwrap_or_else(|| format!("segment {number}"));
