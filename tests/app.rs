@@ -638,6 +638,7 @@ fn a_killed_session_is_restored() {
         before.pixels().zip(after.pixels()).map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c]) as f64).sum::<f64>() / 3.0).sum::<f64>() / n;
     let drawn = |img: &image::RgbaImage| count_in(img, img.width() * 2 / 5, 30, &|p| p.0[..3].iter().any(|&c| c > 20)) as f64;
     let (was, is) = (drawn(&before), drawn(&after));
+    println!("restored: mean {mean:.2} levels, {is} drawn pixels for {was}");
     assert!(
         mean < 8.0 && (is - was).abs() < 0.03 * was,
         "the restored view differs from the killed one: mean {mean:.1} levels, {is} drawn pixels for {was} ({})",

@@ -394,6 +394,42 @@ fn a_volume_the_device_refuses_comes_back_reduced_with_a_message(gpu: &mut Gpu) 
     assert!(img.pixels().filter(|p| p[0] > 100).count() > 50, "the halved rod is drawn");
 }
 
+/// wgpu's error scopes belong to the thread that pushed them (its "std" feature, which
+/// Bevy leaves off): an upload's scope on one thread neither catches another thread's
+/// error nor is popped out of order by it. Without the feature the two scopes below are
+/// one stack, and popping the first panics ("must be popped in reverse order") as the
+/// app's uploads did beside Bevy's shader compiles.
+fn error_scopes_are_kept_per_thread(gpu: &mut Gpu) {
+    use std::sync::mpsc::channel;
+    let device = gpu.off.world_mut().resource::<bevy::render::renderer::RenderDevice>().wgpu_device().clone();
+    let too_long = device.limits().max_texture_dimension_3d + 1;
+    let mine = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let (pushed, has_pushed) = channel();
+    let (pop, may_pop) = channel();
+    let other = std::thread::spawn(move || {
+        let theirs = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let _ = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("longer than the device allows"),
+            size: wgpu::Extent3d { width: too_long, height: 1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: wgpu::TextureFormat::R8Unorm,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let _ = pushed.send(());
+        let _ = may_pop.recv();
+        bevy::tasks::block_on(theirs.pop()).map(|e| e.to_string())
+    });
+    has_pushed.recv().expect("the other thread pushed its scope");
+    let caught_here = bevy::tasks::block_on(mine.pop());
+    let _ = pop.send(());
+    let caught_there = other.join().expect("the other thread popped its scope");
+    assert!(caught_here.is_none(), "this thread's scope caught the other's error: {caught_here:?}");
+    assert!(caught_there.is_some_and(|e| e.contains("exceeds")), "the other thread's scope caught its own error");
+}
+
 /// A GPU test: its name and the function that runs it on the shared device.
 type GpuTest = (&'static str, fn(&mut Gpu));
 
@@ -410,7 +446,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 37] = [
+    let tests: [GpuTest; 38] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -419,6 +455,7 @@ fn main() {
         ("two_datasets_in_one_scene", two_datasets_in_one_scene),
         ("oversized_volumes_are_reduced_with_a_warning", oversized_volumes_are_reduced_with_a_warning),
         ("a_volume_the_device_refuses_comes_back_reduced_with_a_message", a_volume_the_device_refuses_comes_back_reduced_with_a_message),
+        ("error_scopes_are_kept_per_thread", error_scopes_are_kept_per_thread),
         ("lenses_match_the_reference", lenses::lenses_match_the_reference),
         ("lens_ray_directions_match_the_reference", lenses::ray_directions_match_the_reference),
         ("magnifier_scales_a_sphere_by_m_squared", lenses::magnifier_scales_a_sphere_by_m_squared),

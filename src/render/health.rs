@@ -107,26 +107,24 @@ impl Refusal {
 /// Runs `upload` inside out-of-memory and validation error scopes: its result, or the
 /// device's reason for refusing it.
 ///
-/// wgpu keeps error scopes per thread, and the task threads the render world's systems
-/// run on also run Bevy's own work, whose scopes came between a push and its pop (the
-/// app's exploded view panicked with "error scopes must be popped in reverse order"):
-/// the upload runs on a thread of its own, where only its scopes are.
-pub fn scoped<T: Send>(device: &RenderDevice, upload: impl FnOnce() -> T + Send) -> Result<T, String> {
+/// wgpu keeps error scopes per thread only with its "std" feature, which Bevy leaves
+/// off: without it they were one stack for every thread, and Bevy's shader compiles on
+/// the async compute threads popped ours out of order ("error scopes must be popped in
+/// reverse order", in CI). The crate's manifest turns it on, and
+/// the GPU test `error_scopes_are_kept_per_thread` proves it.
+pub fn scoped<T>(device: &RenderDevice, upload: impl FnOnce() -> T) -> Result<T, String> {
     let device = device.wgpu_device();
-    let on_its_own = || {
-        let memory = device.push_error_scope(ErrorFilter::OutOfMemory);
-        let validation = device.push_error_scope(ErrorFilter::Validation);
-        let out = upload();
-        // (Scopes pop in the reverse order; on native backends the futures are ready.)
-        let invalid = bevy::tasks::block_on(validation.pop());
-        let out_of_memory = bevy::tasks::block_on(memory.pop());
-        match (out_of_memory, invalid) {
-            (Some(e), _) => Err(format!("out of GPU memory: {}", innermost(&e))),
-            (None, Some(e)) => Err(format!("beyond what the device allows: {}", innermost(&e))),
-            (None, None) => Ok(out),
-        }
-    };
-    std::thread::scope(|s| s.spawn(on_its_own).join()).unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    let memory = device.push_error_scope(ErrorFilter::OutOfMemory);
+    let validation = device.push_error_scope(ErrorFilter::Validation);
+    let out = upload();
+    // (Scopes pop in the reverse order; on native backends the futures are ready.)
+    let invalid = bevy::tasks::block_on(validation.pop());
+    let out_of_memory = bevy::tasks::block_on(memory.pop());
+    match (out_of_memory, invalid) {
+        (Some(e), _) => Err(format!("out of GPU memory: {}", innermost(&e))),
+        (None, Some(e)) => Err(format!("beyond what the device allows: {}", innermost(&e))),
+        (None, None) => Ok(out),
+    }
 }
 
 /// The line of a wgpu error that says what failed ("Dimension X value 4104 exceeds the

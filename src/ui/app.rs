@@ -372,7 +372,10 @@ fn sync_view(state: Res<AppState>, mut cams: Query<(&mut Camera, &mut VolumeView
 /// caster has drawn the volumes, no pipeline is still compiling and streamed volumes
 /// have converged, as the headless render waits for them, at most
 /// [`crate::render::headless::STREAM_WAIT`]: so the shot never shows a half-built
-/// picture), then exit as soon as it is written.
+/// picture), and at rest at every pixel with as many of its jittered frames averaged
+/// as the shot counts (a view that moved late, as a window's size arriving late on a loaded machine,
+/// is still upscaled or averaging; at most [`SETTLE_FRAMES`] more frames are waited
+/// for it), then exit as soon as it is written.
 fn automation(
     mut state: ResMut<AppState>,
     mut commands: Commands,
@@ -381,6 +384,7 @@ fn automation(
     progress: Option<Res<crate::render::RenderProgress>>,
     (stream, slices): (Option<Res<crate::streaming::bricked::StreamStatus>>, Res<super::slice_views::SliceViews>),
     (mut streaming_since, mut drawn_before): (Local<Option<std::time::Instant>>, Local<u64>),
+    (views, mut waited): (Query<(&crate::interactive::InteractiveResolution, Option<&crate::dataset::view::Accumulate>)>, Local<u32>),
 ) {
     let Some((after, path)) = state.screenshot_and_exit.clone() else { return };
     let settled = progress.as_ref().is_some_and(|p| p.volumes_drawn() > 0 && p.pipelines_settled());
@@ -402,6 +406,15 @@ fn automation(
         }
         warn!("streaming did not converge within {:?}: the screenshot shows what had arrived", crate::render::headless::STREAM_WAIT);
     }
+    if state.frames + 1 == after && !views.iter().all(|(v, a)| refined(v, a, after)) {
+        *waited += 1;
+        if *waited <= SETTLE_FRAMES {
+            return;
+        }
+        if *waited == SETTLE_FRAMES + 1 {
+            warn!("the view did not come to rest within {SETTLE_FRAMES} frames: the screenshot shows it as it is");
+        }
+    }
     state.frames += 1;
     if state.frames == after {
         let _ = std::fs::remove_file(&path);
@@ -410,6 +423,17 @@ fn automation(
     if state.frames > after && (path.exists() || state.frames > after + 20) {
         exit.write(AppExit::Success);
     }
+}
+
+/// How many frames past its count the screenshot automation waits for the view to come
+/// to rest at every pixel.
+const SETTLE_FRAMES: u32 = 120;
+
+/// Whether a view shows the picture a screenshot after `frames` frames is of: not
+/// adapting its resolution, or at rest at every pixel with as many of its jittered
+/// frames averaged as the shot waited for (all of them where it waited longer).
+fn refined(view: &crate::interactive::InteractiveResolution, average: Option<&crate::dataset::view::Accumulate>, frames: u32) -> bool {
+    !view.enabled || (!view.moving && view.scale >= 1.0 && average.is_none_or(|a| a.index + 1 >= a.frames.min(frames)))
 }
 
 /// Runs the app.
