@@ -85,6 +85,31 @@ fn bench_explode_reports_table_1_as_percentages_of_the_plain_frame_rate() {
 }
 
 #[test]
+fn bench_prints_each_goal_beside_its_row_and_marks_those_missed() {
+    // The context group, small: κt = 0 has the goal (≤ ×1.05); the other rows none.
+    let bench = |json: bool| {
+        let mut c = focal();
+        c.args(["bench", "--context", "--frames", "2", "--size", "32x32"]);
+        if json {
+            c.arg("--json");
+        }
+        let out = c.env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into())).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        out
+    };
+    let rows: Vec<serde_json::Value> = serde_json::from_slice(&bench(true).stdout).unwrap();
+    let goals: Vec<(&str, Option<f64>)> = rows.iter().map(|r| (r["config"].as_str().unwrap(), r["goal"].as_f64())).collect();
+    assert_eq!(goals, [("dvr", None), ("context κt 0", Some(1.05)), ("context κt 3", None), ("context κt 3 exact", None)]);
+    let kt0 = &rows[1];
+    assert_eq!(kt0["goal_met"].as_bool(), Some(kt0["ratio"].as_f64().unwrap() <= 1.05), "{kt0}");
+    assert!(rows[0]["goal_met"].is_null());
+    let text = String::from_utf8_lossy(&bench(false).stdout).to_string();
+    let line = text.lines().find(|l| l.contains("context κt 0")).unwrap_or_default();
+    assert!(line.contains("goal ≤ ×1.05") && (line.ends_with(": met]") || line.ends_with(": MISSED]")), "{text}");
+    assert!(text.lines().any(|l| l.starts_with("goals: ") && (l.contains("1 met, 0 missed") || l.contains("0 met, 1 missed"))), "{text}");
+}
+
+#[test]
 fn convert_writes_a_pyramid_that_info_and_render_open() {
     let dir = scratch("cli-convert");
     let zarr = dir.join("fuel.ome.zarr");

@@ -97,7 +97,7 @@ pub fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32, only: &[us
     bench.save_images("explode", &images)?;
     let last = configs.last().map_or(0, |c| c.0.parts.len());
     let note = format!(
-        "{last} parts at rest differ from the plain head by at most {} levels (the selection drawn with its own look); goal: ≥ 80 % of the plain frame rate at 64 parts",
+        "{last} parts at rest differ from the plain head by at most {} levels (the selection drawn with its own look)",
         difference(&images[0], &images[images.len().saturating_sub(2)])
     );
     let names: Vec<&str> = names.iter().map(String::as_str).collect();

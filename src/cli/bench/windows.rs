@@ -146,7 +146,7 @@ pub fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> Result<
     })?;
     bench.save_images("windows", &images)?;
     let note = format!(
-        "the same-look windows and the two halves differ from no window by at most {}, {} and {} levels; goals: one clip window ≤ ×1.05, four ≤ ×1.15",
+        "the same-look windows and the two halves differ from no window by at most {}, {} and {} levels",
         difference(&images[0], &images[1]),
         difference(&images[0], &images[3]),
         difference(&images[0], &images[6])
