@@ -129,6 +129,54 @@ fn a_projections_value_range_leaves_out_the_samples_outside_it() {
     projection_within_matches(Mode::XRay, |c| c.iter().sum::<f32>() / c.len() as f32);
 }
 
+/// A masked image (NaN outside the mask, as resampled and skull-stripped images come):
+/// MIP, MinIP and X-ray take the true values only, as empty space is left out, and a
+/// column of NaN alone draws nothing. (NaN voxels are code 0, below every true value:
+/// the MinIP was that code wherever a ray crossed the mask, the X-ray's mean counted it.)
+#[test]
+fn projections_leave_nan_voxels_out() {
+    use focal::volume::encode::{SampleType, encode_values};
+    let dims = UVec3::new(8, 6, 16);
+    let value = |i: u32, j: u32, k: u32| {
+        let masked = (i == 0 && j == 0) || ((i + j) % 2 == 0 && k >= 8);
+        if masked { f64::NAN } else { 10.0 + ((i * 7 + j * 3 + k * 5) % 40) as f64 }
+    };
+    let values: Vec<f64> = (0..dims.z)
+        .flat_map(|k| (0..dims.y).flat_map(move |j| (0..dims.x).map(move |i| (i, j, k))))
+        .map(|(i, j, k)| value(i, j, k))
+        .collect();
+    let e = encode_values(&values, SampleType::F32).unwrap();
+    let v = Volume::new("masked", Grid::centered(dims, Vec3::ONE), e.voxels, e.map, Source::default()).unwrap();
+    assert_eq!(v.values.no_data, Some(0));
+    let code_max = v.code_max() as f32;
+    for (mode, reduce) in [
+        (Mode::Mip, (|c: &[f32]| c.iter().cloned().fold(f32::MIN, f32::max)) as fn(&[f32]) -> f32),
+        (Mode::MinIp, |c: &[f32]| c.iter().cloned().fold(f32::MAX, f32::min)),
+        (Mode::XRay, |c: &[f32]| c.iter().sum::<f32>() / c.len() as f32),
+    ] {
+        let mut a = Appearance::new(mode, opaque_ramp());
+        a.step = 1.0;
+        let img = render(&RenderScene::single(Arc::new(v.clone()), a), &top_camera(dims), dims.x, dims.y).unwrap();
+        for py in 0..dims.y {
+            for px in 0..dims.x {
+                let (i, j) = (px, dims.y - 1 - py);
+                let column: Vec<f32> =
+                    (0..dims.z).filter(|&k| !value(i, j, k).is_nan()).map(|k| v.code(i, j, k) as f32 / code_max).collect();
+                let got = img.value[(py * dims.x + px) as usize];
+                if column.is_empty() {
+                    assert!(
+                        got.is_nan() && img.at(px, py).truncate() == glam::Vec3::ZERO,
+                        "{mode:?} ({px},{py}) drew {got} from NaN alone"
+                    );
+                } else {
+                    let want = reduce(&column);
+                    assert!((got - want).abs() < 2e-6, "{mode:?} pixel ({px},{py}): {got} vs {want} of the true values");
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn a_projection_split_into_regions_is_one_projection_along_the_whole_ray() {
     // The volume as two regions along the ray (the parts of an exploded view at rest, a

@@ -7,6 +7,7 @@ use crate::context::ContextParams;
 use crate::region::ObjectTable;
 use crate::region::{Appearance, Lookup, Mode, Region, Shading};
 use crate::transfer::Lut;
+use crate::volume::encode::NO_DATA_GAP;
 use crate::volume::pyramid::level_index;
 use crate::volume::sample::VolumeSampler;
 use crate::volume::{BrickGrid, Volume};
@@ -325,14 +326,26 @@ pub fn bounding_sphere(region: &Region, volume: &Volume) -> (Vec3, f32) {
 
 /// The normalised samples a projection of `appearance` takes from `volume`: its
 /// projection range as codes, or all (the ends as far as f32 holds, for the GPU).
+///
+/// A volume with no-data voxels (NaN in the file, `ValueMap::no_data`: code 0, its true
+/// values from [`NO_DATA_GAP`] up) never projects the codes below its first true value:
+/// a MinIP through a masked image would otherwise be the no-data code wherever a ray
+/// crosses the mask, and an X-ray's mean would count it as values.
 pub fn projection_range(appearance: &Appearance, volume: &Volume) -> (f32, f32) {
-    match appearance.projection_range {
+    let (lo, hi) = match appearance.projection_range {
         Some((lo, hi)) => {
             let (a, b) = (volume.real_to_normalized(lo) as f32, volume.real_to_normalized(hi) as f32);
             // (A negative rescale slope turns the range round.)
             (a.min(b), a.max(b))
         }
         None => (f32::MIN, f32::MAX),
+    };
+    match volume.values.no_data {
+        Some(code) => {
+            let first_value = (code as f32 + NO_DATA_GAP as f32) / volume.code_max() as f32;
+            (lo.max(first_value), hi)
+        }
+        None => (lo, hi),
     }
 }
 
