@@ -138,7 +138,7 @@ fn projections_leave_nan_voxels_out() {
     use focal::volume::encode::{SampleType, encode_values};
     let dims = UVec3::new(8, 6, 16);
     let value = |i: u32, j: u32, k: u32| {
-        let masked = (i == 0 && j == 0) || ((i + j) % 2 == 0 && k >= 8);
+        let masked = (i == 0 && j == 0) || ((i + j).is_multiple_of(2) && k >= 8);
         if masked { f64::NAN } else { 10.0 + ((i * 7 + j * 3 + k * 5) % 40) as f64 }
     };
     let values: Vec<f64> = (0..dims.z)
