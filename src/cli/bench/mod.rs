@@ -5,24 +5,23 @@
 //! on/off on the dense head CT), `--modes` (every mode against DVR on the engine
 //! phantom), `--lenses` (magic lenses against no lens on the head CT: a lens of factor
 //! 1 (the lens code alone, same picture), a magnifier with and without anti-aliasing,
-//! the sampling-rate and angular lenses, four lenses at once; goal: the
-//! magnifier with anti-aliasing at most ×1.3; then the feature lens on the labelled head while the camera orbits, its
-//! silhouette found each frame on the GPU or on the CPU; goal: at most 25 %),
+//! the sampling-rate and angular lenses, four lenses at once; then the feature lens on the labelled head while the camera orbits, its
+//! silhouette found each frame on the GPU or on the CPU),
 //! `--context` (context-preserving rendering against DVR on the engine: at κt = 0, the
-//! same picture, the cost of evaluating equation 5; goal: at most 5 %), `--twolevel`
+//! same picture, the cost of evaluating equation 5), `--twolevel`
 //! (two-level rendering of the head CT split by its labels against no objects),
 //! `--windows` (volumetric windows against none, [`windows`]: one and four clip windows
-//! showing the dataset as it is, goals ≤ ×1.05 and ≤ ×1.15; the cutaway, the windows of
+//! showing the dataset as it is; the cutaway, the windows of
 //! the paper's figures 3–6, a window over the head without clip, two halves),
 //! `--explode` (exploded views, [`explode`]: the paper's table 1, 1 to 64 parts at rest
-//! and exploded against the plain ray caster; goal ≥ 80 % at 64 parts), `--bricked`
+//! and exploded against the plain ray caster), `--bricked`
 //! (streaming brick by brick, [`bricked`]: orbiting a source 8× the cache against the
 //! chosen level in memory, a magnifier over it, the first frame of 8192³, peak memory),
 //! `--interactive` (the orbiting camera's frame with its rays at ½ and ¼ of the pixels
 //! per axis and at the app's adaptive resolution, [`interactive`]). Each line
 //! ends with the ratio against its group's baseline; `--json` prints the same as JSON,
 //! `--save DIR` writes each configuration's picture, and `FOCAL_BENCH_SAMPLES=1` prints
-//! every timed frame. Rows with a goal ([`goals`]) show it and whether it was met, and a
+//! every timed frame. Rows with a goal (one table of them: [`goals`]) show it and whether it was met, and a
 //! last line counts the goals met and names those missed. Configurations are timed in interleaved rounds (one frame of each
 //! per round, after an untimed round); a row's ratio is the median over the rounds of its
 //! frame over the baseline's in the same round, and `±` (`ratio_spread` in `--json`)
