@@ -23,11 +23,13 @@
 //! `--save DIR` writes each configuration's picture, and `FOCAL_BENCH_SAMPLES=1` prints
 //! every timed frame. Rows with a goal (one table of them: [`goals`]) show it and whether it was met, and a
 //! last line counts the goals met and names those missed. Configurations are timed in interleaved rounds (one frame of each
-//! per round, after an untimed round); a row's ratio is the median over the rounds of its
-//! frame over the baseline's in the same round, and `±` (`ratio_spread` in `--json`)
-//! half the interquartile range of those ratios. Frames on llvmpipe on a shared machine
-//! scatter by ±10 % from frame to frame: with the default 30 rounds, three runs of the
-//! same build agreed within 3 % on most rows of `--windows` (5 % on the worst).
+//! per round, after an untimed round); a row's ratio is the mean over the rounds of its
+//! frame over the baseline's in the same round, the lowest and highest fifth left out
+//! (`harness::Paired`), and `±` (`ratio_spread` in `--json`) half the interquartile range
+//! of those ratios; its `ms` is the median frame. Frames on llvmpipe on a shared machine
+//! scatter by ±10 % from frame to frame: with the default 60 rounds three runs of the
+//! same build agreed within 3 % on most rows, up to 6 % where a whole run sits apart
+//! (docs/performance.md, "Noise").
 
 use std::sync::Arc;
 
@@ -57,7 +59,7 @@ use harness::{Bench, difference, names, push_group};
 #[derive(Args)]
 pub struct BenchArgs {
     /// Rounds timed (a frame of every configuration each, after one untimed round).
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 60)]
     frames: u32,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256")]
