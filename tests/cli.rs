@@ -59,7 +59,21 @@ fn bench_explode_reports_table_1_as_percentages_of_the_plain_frame_rate() {
     // The paper's table 1, small: 1 and 2 parts, at rest and exploded, against the plain
     // ray caster in the same run (on the GPU: lavapipe where there is none).
     let out = focal()
-        .args(["bench", "--explode", "--parts", "1,2", "--frames", "2", "--size", "32x32", "--resolution", "32", "--json"])
+        .args([
+            "bench",
+            "--explode",
+            "--parts",
+            "1,2",
+            "--frames",
+            "2",
+            "--size",
+            "32x32",
+            "--resolution",
+            "32",
+            "--json",
+            "--processes",
+            "1",
+        ])
         .env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into()))
         .output()
         .unwrap();
@@ -87,11 +101,14 @@ fn bench_explode_reports_table_1_as_percentages_of_the_plain_frame_rate() {
 #[test]
 fn bench_prints_each_goal_beside_its_row_and_marks_those_missed() {
     // The context group, small: κt = 0 has the goal (≤ ×1.05); the other rows none.
+    // (JSON from two processes, their rounds' ratios averaged; text from one.)
     let bench = |json: bool| {
         let mut c = focal();
-        c.args(["bench", "--context", "--frames", "2", "--size", "32x32"]);
+        c.args(["bench", "--context", "--frames", "4", "--size", "32x32"]);
         if json {
-            c.arg("--json");
+            c.args(["--json", "--processes", "2"]);
+        } else {
+            c.args(["--processes", "1"]);
         }
         let out = c.env("WGPU_BACKEND", std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "vulkan".into())).output().unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -103,6 +120,12 @@ fn bench_prints_each_goal_beside_its_row_and_marks_those_missed() {
     let kt0 = &rows[1];
     assert_eq!(kt0["goal_met"].as_bool(), Some(kt0["ratio"].as_f64().unwrap() <= 1.05), "{kt0}");
     assert!(rows[0]["goal_met"].is_null());
+    // Each process's ratio, and the row's ratio their mean.
+    for r in &rows {
+        let by: Vec<f64> = r["ratio_by_process"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        assert_eq!(by.len(), 2, "{r}");
+        assert!((r["ratio"].as_f64().unwrap() - (by[0] + by[1]) / 2.0).abs() < 1e-9, "{r}");
+    }
     let text = String::from_utf8_lossy(&bench(false).stdout).to_string();
     let line = text.lines().find(|l| l.contains("context κt 0")).unwrap_or_default();
     assert!(line.contains("goal ≤ ×1.05") && (line.ends_with(": met]") || line.ends_with(": MISSED]")), "{text}");

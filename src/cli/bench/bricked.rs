@@ -65,7 +65,7 @@ fn counted(bench: &Bench) -> Result<(RayCounts, RayCounts), String> {
 
 fn row(group: &'static str, config: &str, ms: f64, baseline: &str, base_ms: f64, note: String) -> Row {
     Row {
-        group,
+        group: group.into(),
         config: config.into(),
         ms,
         baseline: baseline.into(),
@@ -74,6 +74,7 @@ fn row(group: &'static str, config: &str, ms: f64, baseline: &str, base_ms: f64,
         spread: None,
         gpu_ms: None,
         note,
+        by_process: Vec::new(),
     }
 }
 

@@ -13,8 +13,9 @@ use focal::render::counts::{RayCounts, decode};
 use focal::render::headless::Offscreen;
 use focal::volume::Volume;
 
+#[derive(Clone, Debug)]
 pub(super) struct Row {
-    pub(super) group: &'static str,
+    pub(super) group: String,
     pub(super) config: String,
     pub(super) ms: f64,
     pub(super) baseline: String,
@@ -28,19 +29,23 @@ pub(super) struct Row {
     /// The ray caster's passes on the GPU, ms per frame (timestamp queries).
     pub(super) gpu_ms: Option<f64>,
     pub(super) note: String,
+    /// Each process's ratio, where the rounds ran in several (`super::processes`).
+    pub(super) by_process: Vec<f64>,
 }
 
-/// A configuration's ratio against the first of its [`Bench::rounds`]: the mean of its
-/// per-round ratios (its frame time over the first configuration's in the same round)
-/// with the lowest and highest fifth left out ([`TRIM`]), and half the interquartile
-/// range of those ratios.
+/// A configuration's ratio against the first of its [`Bench::rounds`]: the geometric
+/// mean of its per-round ratios (its frame time over the first configuration's in the
+/// same round) with the lowest and highest fifth left out ([`TRIM`]), and half the
+/// interquartile range of those ratios.
 ///
 /// Why a trimmed mean and not the median: on llvmpipe on a shared two-core machine the
 /// per-round ratios scatter by about ±10 % and nearly normally, where the median needs
 /// about 1.6 times the rounds of a mean for the same precision; the trim keeps a frame
 /// hit by other load from moving it. Three runs of `--lenses`, 60 rounds each (per-frame
 /// times recorded with `FOCAL_BENCH_SAMPLES`), differed by at most 5.9 % per row with the
-/// median and 2.8 % with this mean (at 30 rounds: 7.8 % and 4.1 %).
+/// median and 2.7–2.8 % with such means (at 30 rounds: 7.8 % and about 4 %). Geometric,
+/// as a ratio of two noisy times is skewed: its plain mean lies above the ratio of the
+/// times by about the square of their scatter, the mean of its logarithm does not.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Paired {
     pub(super) ratio: f64,
@@ -63,10 +68,11 @@ impl Paired {
             let (i, t) = (x.floor() as usize, x.fract());
             ratios[i] + (ratios[(i + 1).min(ratios.len() - 1)] - ratios[i]) * t
         };
-        // (scipy.stats.trim_mean: ⌊TRIM·n⌋ cut from each end.)
+        // (As scipy.stats.trim_mean of the logarithms: ⌊TRIM·n⌋ cut from each end.)
         let cut = (TRIM * ratios.len() as f64).floor() as usize;
         let kept = &ratios[cut..ratios.len() - cut];
-        Paired { ratio: kept.iter().sum::<f64>() / kept.len() as f64, spread: 0.5 * (q(0.75) - q(0.25)) }
+        let log_mean = kept.iter().map(|r| r.max(f64::MIN_POSITIVE).ln()).sum::<f64>() / kept.len() as f64;
+        Paired { ratio: log_mean.exp(), spread: 0.5 * (q(0.75) - q(0.25)) }
     }
 }
 
@@ -333,7 +339,7 @@ pub(super) fn push_group(rows: &mut Vec<Row>, bench: &Bench, group: &'static str
     for (i, (name, t)) in names.iter().zip(ms).enumerate() {
         let note = if i == 0 { base_note } else { note };
         rows.push(Row {
-            group,
+            group: group.into(),
             config: name.to_string(),
             ms: *t,
             baseline: base.clone(),
@@ -342,6 +348,7 @@ pub(super) fn push_group(rows: &mut Vec<Row>, bench: &Bench, group: &'static str
             spread: bench.paired.get(i).map(|p| p.spread),
             gpu_ms: bench.gpu_ms.get(i).copied().flatten(),
             note: note.into(),
+            by_process: Vec::new(),
         });
     }
 }
@@ -368,19 +375,21 @@ mod tests {
     use super::Paired;
 
     #[test]
-    fn a_paired_ratio_is_the_trimmed_mean_and_half_the_interquartile_range() {
-        // Five: ⌊0.2·5⌋ = 1 cut from each end of 1.0 1.1 1.2 1.3 2.0, mean of 1.1 1.2 1.3
-        // = 1.2 (the outlier 2.0 left out); quartiles at 1.1 and 1.3.
-        let p = Paired::of(vec![1.3, 1.0, 2.0, 1.2, 1.1]);
-        assert!((p.ratio - 1.2).abs() < 1e-12 && (p.spread - 0.1).abs() < 1e-12, "{p:?}");
-        // Ten: two cut from each end, the mean of the middle six 1.0 1.0 1.0 1.1 1.9 2.0
-        // = 8 / 6 (numpy: np.mean(sorted(a)[2:8]); the median would be 1.05).
-        // Quartiles (numpy) at 1.0 and 1.975.
+    fn a_paired_ratio_is_the_trimmed_geometric_mean_and_half_the_interquartile_range() {
+        // Five: ⌊0.2·5⌋ = 1 cut from each end of 1.0 1.25 1.6 2.0 9.0 (the outlier 9.0
+        // left out), the geometric mean of 1.25 1.6 2.0 = ∛4 (numpy:
+        // np.exp(np.mean(np.log([1.25, 1.6, 2.0])))); quartiles at 1.25 and 2.0.
+        let p = Paired::of(vec![2.0, 1.0, 9.0, 1.6, 1.25]);
+        assert!((p.ratio - 4f64.cbrt()).abs() < 1e-12 && (p.spread - 0.375).abs() < 1e-12, "{p:?}");
+        // Ten: two cut from each end, the middle six 1.0 1.0 1.0 1.1 1.9 2.0: their
+        // geometric mean 4.18^(1/6) = 1.269… (numpy; the median would be 1.05, the
+        // plain mean 1.333). Quartiles (numpy) at 1.0 and 1.975.
         let p = Paired::of(vec![9.0, 1.0, 0.1, 1.1, 8.0, 1.0, 0.2, 1.9, 1.0, 2.0]);
-        assert!((p.ratio - 8.0 / 6.0).abs() < 1e-12 && (p.spread - 0.4875).abs() < 1e-12, "{p:?}");
-        // Four: none cut (⌊0.8⌋ = 0): the mean 1.15; quartiles at 1.075 and 1.225.
-        let p = Paired::of(vec![1.0, 1.1, 1.2, 1.3]);
-        assert!((p.ratio - 1.15).abs() < 1e-12 && (p.spread - 0.075).abs() < 1e-12, "{p:?}");
+        assert!((p.ratio - 4.18f64.powf(1.0 / 6.0)).abs() < 1e-12 && (p.spread - 0.4875).abs() < 1e-12, "{p:?}");
+        // Four: none cut (⌊0.8⌋ = 0): the geometric mean of 1.0 1.1 1.1 1.21 is
+        // 1.4641^(1/4) = 1.1; quartiles at 1.075 and 1.1275.
+        let p = Paired::of(vec![1.0, 1.1, 1.21, 1.1]);
+        assert!((p.ratio - 1.1).abs() < 1e-12 && (p.spread - 0.02625).abs() < 1e-12, "{p:?}");
         assert!(Paired::of(Vec::new()).ratio.is_nan());
     }
 }

@@ -84,7 +84,7 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> 
     let median = frames[frames.len() / 2];
     let scale = scales[scales.len() / 2];
     rows.push(Row {
-        group: "interactive",
+        group: "interactive".into(),
         config: format!("adaptive ({target:.0} ms), orbiting"),
         ms: median,
         baseline: "full resolution, orbiting".into(),
@@ -98,6 +98,7 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> 
             scales[0] * 100.0,
             scales[scales.len() - 1] * 100.0
         ),
+        by_process: Vec::new(),
     });
     Ok(())
 }

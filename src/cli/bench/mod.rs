@@ -23,13 +23,14 @@
 //! `--save DIR` writes each configuration's picture, and `FOCAL_BENCH_SAMPLES=1` prints
 //! every timed frame. Rows with a goal (one table of them: [`goals`]) show it and whether it was met, and a
 //! last line counts the goals met and names those missed. Configurations are timed in interleaved rounds (one frame of each
-//! per round, after an untimed round); a row's ratio is the mean over the rounds of its
-//! frame over the baseline's in the same round, the lowest and highest fifth left out
+//! per round, after an untimed round); a row's ratio is the geometric mean over the rounds
+//! of its frame over the baseline's in the same round, the lowest and highest fifth left out
 //! (`harness::Paired`), and `±` (`ratio_spread` in `--json`) half the interquartile range
-//! of those ratios; its `ms` is the median frame. Frames on llvmpipe on a shared machine
-//! scatter by ±10 % from frame to frame: with the default 60 rounds three runs of the
-//! same build agreed within 3 % on most rows, up to 6 % where a whole run sits apart
-//! (docs/performance.md, "Noise").
+//! of those ratios; its `ms` is the median frame. The rounds (60 by default) run in three
+//! processes of this program one after another, and a row's ratio is the mean of theirs
+//! ([`processes`]: a process has an offset of its own that more rounds in it do not
+//! average). Frames on llvmpipe on a shared machine scatter by ±10 % from frame to frame;
+//! how far runs agree is in docs/performance.md, "Noise".
 
 use std::sync::Arc;
 
@@ -52,15 +53,22 @@ mod explode;
 mod goals;
 mod harness;
 mod interactive;
+mod processes;
 mod windows;
 
-use harness::{Bench, difference, names, push_group};
+use harness::{Bench, Row, difference, names, push_group};
 
-#[derive(Args)]
+#[derive(Args, Clone, Debug, PartialEq)]
 pub struct BenchArgs {
-    /// Rounds timed (a frame of every configuration each, after one untimed round).
+    /// Rounds timed (a frame of every configuration each, after one untimed round), in
+    /// all processes together.
     #[arg(long, default_value_t = 60)]
     frames: u32,
+    /// Processes of this program that take the rounds in turn, each row's ratio the mean
+    /// of theirs: a process's own offset (where llvmpipe's shaders and textures land in
+    /// memory) is not averaged by more rounds in it. 1: all in this one.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=16))]
+    processes: u32,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256")]
     size: String,
@@ -110,22 +118,37 @@ pub struct BenchArgs {
     save: Option<std::path::PathBuf>,
 }
 
+impl BenchArgs {
+    /// The groups by their flags' names, and whether each was asked for.
+    fn groups(&self) -> [(&'static str, bool); 10] {
+        [
+            ("skipping", self.skipping),
+            ("termination", self.termination),
+            ("modes", self.modes),
+            ("lenses", self.lenses),
+            ("context", self.context),
+            ("twolevel", self.twolevel),
+            ("windows", self.windows),
+            ("explode", self.explode),
+            ("bricked", self.bricked),
+            ("interactive", self.interactive),
+        ]
+    }
+}
+
 pub fn run(args: &BenchArgs) -> Result<(), String> {
+    let rows = if args.processes > 1 { processes::measure(args)? } else { measure(args)? };
+    report(&rows, args.json)
+}
+
+/// Every row asked for, measured in this process.
+fn measure(args: &BenchArgs) -> Result<Vec<Row>, String> {
     let (w, h) = args
         .size
         .split_once('x')
         .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
         .ok_or_else(|| format!("size '{}' is not WIDTHxHEIGHT", args.size))?;
-    let all = !(args.skipping
-        || args.termination
-        || args.modes
-        || args.lenses
-        || args.context
-        || args.twolevel
-        || args.windows
-        || args.explode
-        || args.bricked
-        || args.interactive);
+    let all = !args.groups().iter().any(|(_, on)| *on);
     let off = Offscreen::new(w, h, |app| {
         // (Render diagnostics: each pass's GPU time, where the adapter has timestamp
         // queries.)
@@ -312,23 +335,28 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         replace_lenses(bench.off.world_mut(), &[]);
     }
 
-    if args.json {
-        let v: Vec<_> =
-            rows
+    Ok(rows)
+}
+
+/// The rows as text lines (or JSON), and the goals' count.
+fn report(rows: &[Row], json: bool) -> Result<(), String> {
+    if json {
+        let v: Vec<_> = rows
             .iter()
             .map(|r| {
-                let goal = goals::of(r.group, &r.config);
-                json!({"group": r.group, "config": r.config, "ms_per_frame": r.ms, "baseline": r.baseline, "ratio": r.ratio, "frame_rate_percent": r.frame_rate_percent(), "sample_ratio": r.sample_ratio, "ratio_spread": r.spread, "gpu_pass_ms": r.gpu_ms, "goal": goal.map(|g| g.ratio), "goal_met": goal.map(|g| g.met(r.ratio)), "note": r.note})
+                let goal = goals::of(&r.group, &r.config);
+                let by_process = (!r.by_process.is_empty()).then_some(&r.by_process);
+                json!({"group": r.group, "config": r.config, "ms_per_frame": r.ms, "baseline": r.baseline, "ratio": r.ratio, "frame_rate_percent": r.frame_rate_percent(), "sample_ratio": r.sample_ratio, "ratio_spread": r.spread, "ratio_by_process": by_process, "gpu_pass_ms": r.gpu_ms, "goal": goal.map(|g| g.ratio), "goal_met": goal.map(|g| g.met(r.ratio)), "note": r.note})
             })
             .collect();
         println!("{}", serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?);
     } else {
-        for r in &rows {
+        for r in rows {
             let samples = r.sample_ratio.map_or(String::new(), |s| format!(", its picture ×{s:.2} the samples"));
             let spread = r.spread.map_or(String::new(), |s| format!(" ±{s:.2}"));
             let gpu = r.gpu_ms.map_or(String::new(), |g| format!(", rays {g:.1} ms on the GPU"));
             let note = if r.note.is_empty() { String::new() } else { format!("  ({})", r.note) };
-            let goal = goals::of(r.group, &r.config).map_or(String::new(), |g| format!("  [{}]", g.verdict(r.ratio)));
+            let goal = goals::of(&r.group, &r.config).map_or(String::new(), |g| format!("  [{}]", g.verdict(r.ratio)));
             println!(
                 "{:<12} {:<16} {:>9.1} ms/frame  ×{:.2}{spread} vs {} ({:.0} % of its frame rate{samples}{gpu}){note}{goal}",
                 r.group,
@@ -341,8 +369,8 @@ pub fn run(args: &BenchArgs) -> Result<(), String> {
         }
     }
     // (On standard error beside the JSON.)
-    if let Some(summary) = goals::summary(rows.iter().map(|r| (r.group, r.config.as_str(), r.ratio))) {
-        if args.json { eprintln!("{summary}") } else { println!("{summary}") }
+    if let Some(summary) = goals::summary(rows.iter().map(|r| (r.group.as_str(), r.config.as_str(), r.ratio))) {
+        if json { eprintln!("{summary}") } else { println!("{summary}") }
     }
     Ok(())
 }
