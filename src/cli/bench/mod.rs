@@ -35,7 +35,6 @@
 use std::sync::Arc;
 
 use bevy::prelude::*;
-use clap::Args;
 use focal::FocalPlugins;
 use focal::context::{ContextParams, Power};
 use focal::dataset::VolumeView;
@@ -48,6 +47,7 @@ use focal::transfer::{LabelTransfer, presets};
 use focal::volume::phantom::{self, Phantom};
 use serde_json::json;
 
+mod args;
 mod bricked;
 mod explode;
 mod goals;
@@ -56,85 +56,8 @@ mod interactive;
 mod processes;
 mod windows;
 
+pub use args::BenchArgs;
 use harness::{Bench, Row, difference, names, push_group};
-
-#[derive(Args, Clone, Debug, PartialEq)]
-pub struct BenchArgs {
-    /// Rounds timed (a frame of every configuration each, after one untimed round), in
-    /// all processes together.
-    #[arg(long, default_value_t = 60)]
-    frames: u32,
-    /// Processes of this program that take the rounds in turn, each row's ratio the mean
-    /// of theirs: a process's own offset (where llvmpipe's shaders and textures land in
-    /// memory) is not averaged by more rounds in it. 1: all in this one.
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=16))]
-    processes: u32,
-    /// Image size WIDTHxHEIGHT.
-    #[arg(long, default_value = "256x256")]
-    size: String,
-    /// Phantom resolution.
-    #[arg(long, default_value_t = 128)]
-    resolution: u32,
-    /// Only the empty-space-skipping group.
-    #[arg(long)]
-    skipping: bool,
-    /// Only the early-termination group.
-    #[arg(long)]
-    termination: bool,
-    /// Only the modes group.
-    #[arg(long)]
-    modes: bool,
-    /// Only the lenses group.
-    #[arg(long)]
-    lenses: bool,
-    /// Only the context-preserving group.
-    #[arg(long)]
-    context: bool,
-    /// Only the two-level group.
-    #[arg(long)]
-    twolevel: bool,
-    /// Only the volumetric windows group.
-    #[arg(long)]
-    windows: bool,
-    /// Only the exploded views group (the paper's table 1).
-    #[arg(long)]
-    explode: bool,
-    /// Only the bricked-streaming group (issue 23).
-    #[arg(long)]
-    bricked: bool,
-    /// Only the interactive-resolution group (the moving camera at fewer pixels).
-    #[arg(long)]
-    interactive: bool,
-    /// With --explode: only these part counts (1, 2, 4, 8, 16, 32, 64; comma-separated).
-    #[arg(long, value_delimiter = ',', value_name = "N,...")]
-    parts: Vec<usize>,
-    /// Print JSON.
-    #[arg(long)]
-    json: bool,
-    /// Save the picture of every configuration timed in rounds into this folder
-    /// (`GROUP-N.png`, N in the order of the group's lines) and heat maps of their
-    /// samples per ray (`GROUP-samples-N.png`).
-    #[arg(long, value_name = "DIR")]
-    save: Option<std::path::PathBuf>,
-}
-
-impl BenchArgs {
-    /// The groups by their flags' names, and whether each was asked for.
-    fn groups(&self) -> [(&'static str, bool); 10] {
-        [
-            ("skipping", self.skipping),
-            ("termination", self.termination),
-            ("modes", self.modes),
-            ("lenses", self.lenses),
-            ("context", self.context),
-            ("twolevel", self.twolevel),
-            ("windows", self.windows),
-            ("explode", self.explode),
-            ("bricked", self.bricked),
-            ("interactive", self.interactive),
-        ]
-    }
-}
 
 pub fn run(args: &BenchArgs) -> Result<(), String> {
     let rows = if args.processes > 1 { processes::measure(args)? } else { measure(args)? };

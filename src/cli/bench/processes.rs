@@ -12,12 +12,11 @@
 //! ratio is the mean of the processes' ratios (`ratio_by_process` in `--json`), its
 //! `ms` and GPU time their medians, its spread the mean of theirs.
 
-use std::ffi::OsString;
 use std::process::{Command, Stdio};
 
 use serde_json::Value;
 
-use super::BenchArgs;
+use super::args::BenchArgs;
 use super::harness::Row;
 
 /// Runs `args` in `args.processes` processes of this binary and merges their rows.
@@ -49,30 +48,6 @@ pub(super) fn measure(args: &BenchArgs) -> Result<Vec<Row>, String> {
         runs.push(rows_of(&v).map_err(|e| format!("bench process {} of {n}: {e}", k + 1))?);
     }
     merge(runs)
-}
-
-impl BenchArgs {
-    /// The arguments of one of its processes: `frames` rounds, JSON, one process; the
-    /// picture folder only with `save`.
-    pub(super) fn child(&self, frames: u32, save: bool) -> Vec<OsString> {
-        let mut a: Vec<OsString> = ["bench", "--processes", "1", "--json", "--frames"].map(OsString::from).to_vec();
-        a.push(frames.to_string().into());
-        a.extend(["--size".into(), self.size.clone().into(), "--resolution".into(), self.resolution.to_string().into()]);
-        for (flag, on) in self.groups() {
-            if on {
-                a.push(format!("--{flag}").into());
-            }
-        }
-        if !self.parts.is_empty() {
-            a.push("--parts".into());
-            a.push(self.parts.iter().map(|p| p.to_string()).collect::<Vec<_>>().join(",").into());
-        }
-        if save && let Some(dir) = &self.save {
-            a.push("--save".into());
-            a.push(dir.clone().into());
-        }
-        a
-    }
 }
 
 /// The rows of a process's `--json`.
@@ -146,6 +121,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 mod tests {
     use super::*;
     use clap::Parser;
+    use std::ffi::OsString;
 
     #[derive(Parser)]
     struct Cli {
