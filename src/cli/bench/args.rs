@@ -16,6 +16,15 @@ pub struct BenchArgs {
     /// memory) is not averaged by more rounds in it. 1: all in this one.
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=16))]
     pub(super) processes: u32,
+    /// The standard error (%) aimed at for each ratio timed in rounds: after the first
+    /// processes, a group with a row above it takes the same rounds again in one more
+    /// process, until none is or --max-processes is reached (with --processes 2 or
+    /// more). 0: no more processes.
+    #[arg(long, default_value_t = 1.0, value_name = "PCT")]
+    pub(super) precision: f64,
+    /// At most this many processes for a group's rows, the first ones included.
+    #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub(super) max_processes: u32,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256")]
     pub(super) size: String,
@@ -83,17 +92,24 @@ impl BenchArgs {
     }
 
     /// The arguments of one of its processes: `frames` rounds, JSON, one process; the
-    /// picture folder only with `save`.
-    pub(super) fn child(&self, frames: u32, save: bool) -> Vec<OsString> {
+    /// picture folder only with `save`; `only` these groups (by their flags' names, as
+    /// the rows name them), or those asked for.
+    pub(super) fn child(&self, frames: u32, save: bool, only: Option<&[String]>) -> Vec<OsString> {
         let mut a: Vec<OsString> = ["bench", "--processes", "1", "--json", "--frames"].map(OsString::from).to_vec();
         a.push(frames.to_string().into());
         a.extend(["--size".into(), self.size.clone().into(), "--resolution".into(), self.resolution.to_string().into()]);
-        for (flag, on) in self.groups() {
-            if on {
+        a.extend(["--precision".into(), self.precision.to_string().into()]);
+        a.extend(["--max-processes".into(), self.max_processes.to_string().into()]);
+        let wanted = |flag: &str, asked: bool| only.map_or(asked, |only| only.iter().any(|g| g == flag));
+        for (flag, asked) in self.groups() {
+            if wanted(flag, asked) {
                 a.push(format!("--{flag}").into());
             }
         }
-        if !self.parts.is_empty() {
+        // (The part counts go with the exploded views: asked for, or every group.)
+        let every = !self.groups().iter().any(|(_, asked)| *asked);
+        let explode = wanted("explode", self.explode || every);
+        if explode && !self.parts.is_empty() {
             a.push("--parts".into());
             a.push(self.parts.iter().map(|p| p.to_string()).collect::<Vec<_>>().join(",").into());
         }

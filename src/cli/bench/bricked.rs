@@ -72,6 +72,7 @@ fn row(group: &'static str, config: &str, ms: f64, baseline: &str, base_ms: f64,
         ratio: ms / base_ms.max(1e-9),
         sample_ratio: None,
         spread: None,
+        se: None,
         gpu_ms: None,
         note,
         by_process: Vec::new(),
@@ -82,7 +83,7 @@ fn row(group: &'static str, config: &str, ms: f64, baseline: &str, base_ms: f64,
 fn paired_row(bench: &Bench, i: usize, config: &str, ms: &[f64], baseline: &str, note: String) -> Row {
     let base = row("bricked", config, ms[i], baseline, ms[0], note);
     match bench.paired.get(i) {
-        Some(p) => Row { ratio: p.ratio, spread: Some(p.spread), gpu_ms: bench.gpu_ms.get(i).copied().flatten(), ..base },
+        Some(p) => Row { ratio: p.ratio, spread: Some(p.spread), se: Some(p.se), gpu_ms: bench.gpu_ms.get(i).copied().flatten(), ..base },
         None => base,
     }
 }

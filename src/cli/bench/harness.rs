@@ -26,6 +26,9 @@ pub(super) struct Row {
     /// Half the interquartile range of the ratio over the rounds (each round's frame
     /// against the baseline's of the same round), where timed in rounds.
     pub(super) spread: Option<f64>,
+    /// The ratio's standard error relative to it ([`Paired::se`]; over processes,
+    /// `super::processes::combined_se`), where timed in rounds.
+    pub(super) se: Option<f64>,
     /// The ray caster's passes on the GPU, ms per frame (timestamp queries).
     pub(super) gpu_ms: Option<f64>,
     pub(super) note: String,
@@ -46,10 +49,17 @@ pub(super) struct Row {
 /// median and 2.7–2.8 % with such means (at 30 rounds: 7.8 % and about 4 %). Geometric,
 /// as a ratio of two noisy times is skewed: its plain mean lies above the ratio of the
 /// times by about the square of their scatter, the mean of its logarithm does not.
+///
+/// `se` is the standard error of that trimmed mean of the logarithms, which is the
+/// ratio's standard error relative to it (Tukey and McLaughlin's estimate: the standard
+/// deviation of the logarithms winsorized at the same cut, over (1 − 2·TRIM)·√n, as
+/// `scipy.stats.mstats.trimmed_stde`); `super::processes` adds processes to a group
+/// until each of its rows' is small enough.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Paired {
     pub(super) ratio: f64,
     pub(super) spread: f64,
+    pub(super) se: f64,
 }
 
 /// The share of the per-round ratios left out at each end of [`Paired::ratio`].
@@ -59,7 +69,7 @@ impl Paired {
     /// From the per-round ratios.
     pub(super) fn of(mut ratios: Vec<f64>) -> Paired {
         if ratios.is_empty() {
-            return Paired { ratio: f64::NAN, spread: f64::NAN };
+            return Paired { ratio: f64::NAN, spread: f64::NAN, se: f64::NAN };
         }
         ratios.sort_by(f64::total_cmp);
         let q = |f: f64| {
@@ -70,9 +80,16 @@ impl Paired {
         };
         // (As scipy.stats.trim_mean of the logarithms: ⌊TRIM·n⌋ cut from each end.)
         let cut = (TRIM * ratios.len() as f64).floor() as usize;
-        let kept = &ratios[cut..ratios.len() - cut];
-        let log_mean = kept.iter().map(|r| r.max(f64::MIN_POSITIVE).ln()).sum::<f64>() / kept.len() as f64;
-        Paired { ratio: log_mean.exp(), spread: 0.5 * (q(0.75) - q(0.25)) }
+        let n = ratios.len();
+        let logs: Vec<f64> = ratios.iter().map(|r| r.max(f64::MIN_POSITIVE).ln()).collect();
+        let kept = &logs[cut..n - cut];
+        let log_mean = kept.iter().sum::<f64>() / kept.len() as f64;
+        // The logarithms winsorized: each cut one replaced by the nearest kept one.
+        let winsorized: Vec<f64> = logs.iter().map(|l| l.clamp(kept[0], kept[kept.len() - 1])).collect();
+        let w_mean = winsorized.iter().sum::<f64>() / n as f64;
+        let w_var = winsorized.iter().map(|l| (l - w_mean).powi(2)).sum::<f64>() / (n as f64 - 1.0);
+        let se = if n < 2 { f64::NAN } else { w_var.sqrt() / ((1.0 - 2.0 * TRIM) * (n as f64).sqrt()) };
+        Paired { ratio: log_mean.exp(), spread: 0.5 * (q(0.75) - q(0.25)), se }
     }
 }
 
@@ -346,6 +363,7 @@ pub(super) fn push_group(rows: &mut Vec<Row>, bench: &Bench, group: &'static str
             ratio: bench.paired.get(i).map_or(t / ms[0].max(1e-9), |p| p.ratio),
             sample_ratio: base_samples.zip(bench.counts.get(i)).map(|(b, c)| c.samples as f64 / b.max(1) as f64),
             spread: bench.paired.get(i).map(|p| p.spread),
+            se: bench.paired.get(i).map(|p| p.se),
             gpu_ms: bench.gpu_ms.get(i).copied().flatten(),
             note: note.into(),
             by_process: Vec::new(),
@@ -379,17 +397,20 @@ mod tests {
         // Five: ⌊0.2·5⌋ = 1 cut from each end of 1.0 1.25 1.6 2.0 9.0 (the outlier 9.0
         // left out), the geometric mean of 1.25 1.6 2.0 = ∛4 (numpy:
         // np.exp(np.mean(np.log([1.25, 1.6, 2.0])))); quartiles at 1.25 and 2.0.
+        // Its standard error: scipy.stats.mstats.trimmed_stde(np.log(r), limits=(0.2, 0.2)).
         let p = Paired::of(vec![2.0, 1.0, 9.0, 1.6, 1.25]);
         assert!((p.ratio - 4f64.cbrt()).abs() < 1e-12 && (p.spread - 0.375).abs() < 1e-12, "{p:?}");
+        assert!((p.se - 0.175204605085629).abs() < 1e-12, "{p:?}");
         // Ten: two cut from each end, the middle six 1.0 1.0 1.0 1.1 1.9 2.0: their
         // geometric mean 4.18^(1/6) = 1.269… (numpy; the median would be 1.05, the
         // plain mean 1.333). Quartiles (numpy) at 1.0 and 1.975.
         let p = Paired::of(vec![9.0, 1.0, 0.1, 1.1, 8.0, 1.0, 0.2, 1.9, 1.0, 2.0]);
         assert!((p.ratio - 4.18f64.powf(1.0 / 6.0)).abs() < 1e-12 && (p.spread - 0.4875).abs() < 1e-12, "{p:?}");
+        assert!((p.se - 0.181649911596974).abs() < 1e-12, "{p:?}");
         // Four: none cut (⌊0.8⌋ = 0): the geometric mean of 1.0 1.1 1.1 1.21 is
         // 1.4641^(1/4) = 1.1; quartiles at 1.075 and 1.1275.
         let p = Paired::of(vec![1.0, 1.1, 1.21, 1.1]);
         assert!((p.ratio - 1.1).abs() < 1e-12 && (p.spread - 0.02625).abs() < 1e-12, "{p:?}");
-        assert!(Paired::of(Vec::new()).ratio.is_nan());
+        assert!(Paired::of(Vec::new()).ratio.is_nan() && Paired::of(vec![1.2]).se.is_nan());
     }
 }

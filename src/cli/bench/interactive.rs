@@ -91,6 +91,7 @@ pub(super) fn group(bench: &mut Bench, rows: &mut Vec<Row>, resolution: u32) -> 
         ratio: median / full.max(1e-9),
         sample_ratio: None,
         spread: None,
+        se: None,
         gpu_ms: None,
         note: format!(
             "median frame {median:.1} ms against the {target:.0} ms it holds; settled at {:.0} % of the pixels per axis (range {:.0}–{:.0} %)",

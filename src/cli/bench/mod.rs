@@ -29,7 +29,9 @@
 //! of those ratios; its `ms` is the median frame. The rounds (60 by default) run in three
 //! processes of this program one after another, and a row's ratio is the mean of theirs
 //! ([`processes`]: a process has an offset of its own that more rounds in it do not
-//! average). Frames on llvmpipe on a shared machine scatter by ±10 % from frame to frame;
+//! average); a group whose ratios' standard error (`ratio_se`) is still above 1 %
+//! (`--precision`) takes the same rounds again in more processes, up to 12
+//! (`--max-processes`). Frames on llvmpipe on a shared machine scatter by ±10 % from frame to frame;
 //! how far runs agree is in docs/performance.md, "Noise".
 
 use std::sync::Arc;
@@ -269,7 +271,7 @@ fn report(rows: &[Row], json: bool) -> Result<(), String> {
             .map(|r| {
                 let goal = goals::of(&r.group, &r.config);
                 let by_process = (!r.by_process.is_empty()).then_some(&r.by_process);
-                json!({"group": r.group, "config": r.config, "ms_per_frame": r.ms, "baseline": r.baseline, "ratio": r.ratio, "frame_rate_percent": r.frame_rate_percent(), "sample_ratio": r.sample_ratio, "ratio_spread": r.spread, "ratio_by_process": by_process, "gpu_pass_ms": r.gpu_ms, "goal": goal.map(|g| g.ratio), "goal_met": goal.map(|g| g.met(r.ratio)), "note": r.note})
+                json!({"group": r.group, "config": r.config, "ms_per_frame": r.ms, "baseline": r.baseline, "ratio": r.ratio, "frame_rate_percent": r.frame_rate_percent(), "sample_ratio": r.sample_ratio, "ratio_spread": r.spread, "ratio_se": r.se, "ratio_by_process": by_process, "gpu_pass_ms": r.gpu_ms, "goal": goal.map(|g| g.ratio), "goal_met": goal.map(|g| g.met(r.ratio)), "note": r.note})
             })
             .collect();
         println!("{}", serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?);
