@@ -371,6 +371,16 @@ pub(super) fn push_group(rows: &mut Vec<Row>, bench: &Bench, group: &'static str
     }
 }
 
+/// The CPU the bench runs on, from `/proc/cpuinfo`'s first model name (and family and
+/// model, which tell a generation apart where the name does not), with its threads.
+pub(super) fn cpu(cpuinfo: &str, threads: usize) -> String {
+    let field =
+        |key: &str| cpuinfo.lines().find_map(|l| l.split_once(':').filter(|(k, _)| k.trim() == key).map(|(_, v)| v.trim().to_string()));
+    let name = field("model name").unwrap_or_else(|| "an unknown CPU".into());
+    let generation = field("cpu family").zip(field("model")).map_or(String::new(), |(f, m)| format!(", family {f} model {m}"));
+    format!("{name}{generation}, {threads} threads")
+}
+
 /// Largest channel difference between two images, in 8-bit levels.
 pub(super) fn difference(a: &image::RgbaImage, b: &image::RgbaImage) -> u8 {
     a.pixels().zip(b.pixels()).flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c]))).max().unwrap_or(0)
@@ -390,7 +400,14 @@ pub(super) fn share_differing(a: &image::RgbaImage, b: &image::RgbaImage, levels
 
 #[cfg(test)]
 mod tests {
-    use super::Paired;
+    use super::{Paired, cpu};
+
+    #[test]
+    fn the_cpu_is_named_with_its_family_model_and_threads() {
+        let info = "processor\t: 0\nvendor_id\t: AuthenticAMD\ncpu family\t: 25\nmodel\t\t: 1\nmodel name\t: AMD EPYC\n\nprocessor\t: 1\nmodel name\t: AMD EPYC\n";
+        assert_eq!(cpu(info, 2), "AMD EPYC, family 25 model 1, 2 threads");
+        assert_eq!(cpu("", 4), "an unknown CPU, 4 threads");
+    }
 
     #[test]
     fn a_paired_ratio_is_the_trimmed_geometric_mean_and_half_the_interquartile_range() {

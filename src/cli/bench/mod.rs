@@ -79,7 +79,11 @@ fn measure(args: &BenchArgs) -> Result<Vec<Row>, String> {
         // queries.)
         app.add_plugins((FocalPlugins, bevy::render::diagnostic::RenderDiagnosticsPlugin));
     })?;
-    eprintln!("GPU: {}  image {w}×{h}, {} rounds", off.adapter_name(), args.frames);
+    // (The CPU too: on llvmpipe the ratios depend on it, docs/performance.md "Another
+    // machine, other ratios".)
+    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let threads = std::thread::available_parallelism().map_or(0, |n| n.get());
+    eprintln!("GPU: {} on {}  image {w}×{h}, {} rounds", off.adapter_name(), harness::cpu(&cpuinfo, threads), args.frames);
     let mut bench = Bench {
         off,
         frames: args.frames.max(1),
