@@ -1,6 +1,6 @@
 //! The bench's machinery: an offscreen view that shows one volume, configurations timed
-//! in interleaved rounds (medians), samples counted by the CPU reference, and the rows
-//! of the report.
+//! in interleaved rounds (each row's median frame and its per-round ratios, [`Paired`]),
+//! samples counted by the CPU reference, and the rows of the report.
 
 use std::sync::Arc;
 
