@@ -54,7 +54,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 21] = [
+const DEFS: [&str; 20] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -75,7 +75,6 @@ const DEFS: [&str; 21] = [
     "BRICKED_ONLY",
     "OWN_VALUES",
     "INSETS",
-    "MANY_INSETS",
 ];
 
 #[test]
@@ -114,16 +113,11 @@ fn every_shader_variant_composes_and_validates() {
                 || (bits & bit("HAS_TWO_LEVEL") != 0 && ((bits & !own).count_ones() <= 3 || (bits | bricked | bit("HAS_HOLES")) == full)))
     };
     // Windows drawn in place touch the DVR loop alone: with DVR and up to two other
-    // defs (one with four slots), and with all of them.
-    let insets = bit("INSETS") | bit("MANY_INSETS");
+    // defs, and with all of them.
+    let insets = bit("INSETS");
     let possible = |bits: u32| {
         let others = (bits & !insets & !bit("HAS_DVR")).count_ones();
-        let most = if bits & bit("MANY_INSETS") != 0 { 1 } else { 2 };
-        possible(bits)
-            && (bits & insets == 0
-                || (needs("MANY_INSETS", "INSETS", bits)
-                    && needs("INSETS", "HAS_DVR", bits)
-                    && (others <= most || bits == full & !bit("HAS_HOLES"))))
+        possible(bits) && (bits & insets == 0 || (needs("INSETS", "HAS_DVR", bits) && (others <= 2 || bits == full & !bit("HAS_HOLES"))))
     };
     let variants: Vec<u32> = (0u32..(1 << DEFS.len())).filter(|b| possible(*b)).collect();
     // (On every core: the variants are independent, and one after another they were

@@ -7,55 +7,55 @@
 // comparisons and a select a window, where the windows as regions of their own cost a
 // segment each (on llvmpipe the lanes of a SIMD group wait at every segment's end for
 // the group's longest one).
+//
+// The windows' boxes come from the scene's uniform buffer (SceneInfo.insets), in a loop
+// of constant length that the compiler unrolls: every lane reads the same planes. Read
+// through the region's record (its windows' records, then their planes in the storage
+// buffer, at addresses each lane loaded for itself), the same intervals once per
+// segment cost more than all the samples' choices: one window ×1.09 of the frame
+// without it, four ×1.36, against ×1.05 and ×1.04 (bench --windows, llvmpipe on an AMD
+// EPYC, 2026-12-07).
 
-#import focal::types::{Region, REGION_INSETS}
-#import focal::bindings::regions
-#import focal::regions::region_interval
+#import focal::types::MAX_INSETS
+#import focal::bindings::scene
+#import focal::regions::cut_by_plane
 
-#ifdef MANY_INSETS
-// (render::pack::MAX_INSETS)
-const INSET_SLOTS: u32 = 4u;
-#else
-const INSET_SLOTS: u32 = 1u;
-#endif
-
-// The current region's windows on this ray: the ray's interval in each (empty where none)
-// and the window's table offset in the lookup atlas. (Arrays a loop of constant length
-// reads: the compiler unrolls it and keeps them in registers.)
+// The current region's windows on this ray, one in each component (render::pack::
+// MAX_INSETS): the ray's interval in each (empty where none) and the window's table
+// offset in the lookup atlas. (Vectors read at constant components: registers.)
 struct Insets {
-    enter: array<f32, INSET_SLOTS>,
-    leave: array<f32, INSET_SLOTS>,
-    lut: array<u32, INSET_SLOTS>,
+    enter: vec4<f32>,
+    leave: vec4<f32>,
+    lut: vec4<u32>,
 }
 
 var<private> insets: Insets;
 
-// The windows region r draws in place, on the ray from origin along dir (none when r
-// draws none). (Each in its own slot: slots written at an index the loop computes
-// would keep the arrays in memory, and each sample reads them.)
-fn set_insets(r: Region, origin: vec3<f32>, dir: vec3<f32>) {
-    let on = (r.flags & REGION_INSETS) != 0u;
-    for (var i = 0u; i < INSET_SLOTS; i++) {
-        insets.enter[i] = 3.4e38;
-        insets.leave[i] = -3.4e38;
-        insets.lut[i] = r.lut_offset;
-        let record = r.objects[i];
-        if on && record != 0u {
-            let w = regions[record - 1u];
-            let iv = region_interval(w, origin, dir);
-            insets.enter[i] = max(iv.x, 0.0);
-            insets.leave[i] = iv.y;
-            insets.lut[i] = w.lut_offset;
+// The windows drawn in place in region record `record`, whose own table is at `own`,
+// on the ray from origin along dir (none where it draws none).
+fn set_insets(record: u32, own: u32, origin: vec3<f32>, dir: vec3<f32>) {
+    var enter = vec4(3.4e38);
+    var leave = vec4(-3.4e38);
+    var lut = vec4(own);
+    for (var w = 0u; w < MAX_INSETS; w++) {
+        if w < scene.inset_count && scene.insets[w].host == record {
+            var iv = vec2(-3.4e38, 3.4e38);
+            for (var i = 0u; i < 6u; i++) {
+                iv = cut_by_plane(iv, scene.insets[w].planes[i], origin, dir);
+            }
+            enter[w] = iv.x;
+            leave[w] = iv.y;
+            lut[w] = scene.insets[w].lut_offset;
         }
     }
+    insets = Insets(enter, leave, lut);
 }
 
 // The table offset of the sample at ray parameter t of a region whose own is `own`
 // (windows are disjoint: at most one holds t).
 fn inset_lut(own: u32, t: f32) -> u32 {
-    var lut = own;
-    for (var i = 0u; i < INSET_SLOTS; i++) {
-        lut = select(lut, insets.lut[i], t >= insets.enter[i] && t <= insets.leave[i]);
-    }
-    return lut;
+    var lut = select(own, insets.lut.x, t >= insets.enter.x && t <= insets.leave.x);
+    lut = select(lut, insets.lut.y, t >= insets.enter.y && t <= insets.leave.y);
+    lut = select(lut, insets.lut.z, t >= insets.enter.z && t <= insets.leave.z);
+    return select(lut, insets.lut.w, t >= insets.enter.w && t <= insets.leave.w);
 }

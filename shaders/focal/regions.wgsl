@@ -34,27 +34,23 @@ fn in_hole(r: Region, p: vec3<f32>) -> bool {
 // [t0, t1] of the ray inside the `count` half-spaces from planes[offset] (reference:
 // region::ray_convex).
 fn convex_interval(offset: u32, count: u32, origin: vec3<f32>, dir: vec3<f32>) -> vec2<f32> {
-    var t0 = -3.4e38;
-    var t1 = 3.4e38;
+    var iv = vec2(-3.4e38, 3.4e38);
+    // (No early return: a loop all lanes run alike keeps its loads uniform.)
     for (var i = 0u; i < count; i++) {
-        let p = planes[offset + i];
-        let denom = dot(p.xyz, dir);
-        let dist = p.w - dot(p.xyz, origin);
-        // (No early return: a loop all lanes run alike keeps its loads uniform.)
-        if abs(denom) < 1e-12 {
-            if dist < 0.0 {
-                t0 = 3.4e38;
-            }
-        } else {
-            let t = dist / denom;
-            if denom < 0.0 {
-                t0 = max(t0, t);
-            } else {
-                t1 = min(t1, t);
-            }
-        }
+        iv = cut_by_plane(iv, planes[offset + i], origin, dir);
     }
-    return vec2(t0, t1);
+    return iv;
+}
+
+// The ray's interval iv less the part outside half-space p (n·x − d ≤ 0: p = (n, d)).
+fn cut_by_plane(iv: vec2<f32>, p: vec4<f32>, origin: vec3<f32>, dir: vec3<f32>) -> vec2<f32> {
+    let denom = dot(p.xyz, dir);
+    let dist = p.w - dot(p.xyz, origin);
+    if abs(denom) < 1e-12 {
+        return select(iv, vec2(3.4e38, iv.y), dist < 0.0);
+    }
+    let t = dist / denom;
+    return select(vec2(iv.x, min(iv.y, t)), vec2(max(iv.x, t), iv.y), denom < 0.0);
 }
 
 // Whether the line origin + t·dir comes within the sphere (centre, radius).

@@ -84,7 +84,21 @@ struct SceneInfo {
     lut_atlas_width: u32,
     // Bound on the iterations of every loop along a ray (render::pack::march_bound).
     max_steps: u32,
-    pad_b: u32,
+    // The clip windows drawn in their datasets' samples, insets[0 … inset_count)
+    // (focal::insets).
+    inset_count: u32,
+    insets: array<Inset, MAX_INSETS>,
+}
+
+// (render::pack::MAX_INSETS)
+const MAX_INSETS: u32 = 4u;
+
+// A clip window drawn in place: its box's planes (n·x − d, negative inside), the
+// record of the region it is drawn in, its table's offset in the lookup atlas.
+struct Inset {
+    planes: array<vec4<f32>, 6>,
+    host: u32,
+    lut_offset: u32,
 }
 
 const MODE_DVR: u32 = 0u;
@@ -112,8 +126,6 @@ const REGION_KEEP_UNSELECTED: u32 = 32u;
 const REGION_COMPANION: u32 = 64u;
 // A segmented region whose labels lie on its data's grid (two_level::own_value).
 const REGION_ON_GRID: u32 = 128u;
-// Clip windows are drawn in this region's samples (records + 1: objects; focal::insets).
-const REGION_INSETS: u32 = 512u;
 
 const VIEW_JITTER: u32 = 1u;
 const VIEW_SKIP_EMPTY: u32 = 2u;

@@ -51,9 +51,6 @@ pub mod region_flags {
     /// A segmented region asks for [`ON_GRID`]'s boundaries (`Segmentation::own_values`;
     /// given where its labels lie on the grid: bricked data on level 0's).
     pub const OWN_VALUES: u32 = 256;
-    /// Clip windows are drawn in this region's samples, in place of its holes (their
-    /// records + 1: `objects`, 0 where none; `render::pack::insets`).
-    pub const INSETS: u32 = 512;
 }
 
 /// Scene features: which parts of the shader a scene needs (shader defs).
@@ -110,10 +107,9 @@ pub mod features {
     /// pipeline has it only then, `render::pipeline::lens_features`).
     pub const MIP_READS: u32 = 1 << 24;
 
-    /// Some region draws clip windows in place (`render::pack::insets`): one window a
-    /// region, or with [`MANY_INSETS`] up to `render::pack::MAX_INSETS`.
+    /// Some region draws clip windows in place (`render::pack::insets`; the windows:
+    /// [`super::GpuSceneInfo::insets`]).
     pub const INSETS: u32 = 1 << 25;
-    pub const MANY_INSETS: u32 = 1 << 26;
 
     /// Shader def names of the lens kinds and shapes, by bit.
     pub const LENS_NAMES: [(u32, &str); 5] = [
@@ -125,7 +121,7 @@ pub mod features {
     ];
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 21] = [
+    pub const NAMES: [(u32, &str); 20] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -146,7 +142,6 @@ pub mod features {
         (BRICKED_ONLY, "BRICKED_ONLY"),
         (OWN_VALUES, "OWN_VALUES"),
         (INSETS, "INSETS"),
-        (MANY_INSETS, "MANY_INSETS"),
     ];
 }
 
@@ -221,8 +216,7 @@ pub struct GpuRegion {
     /// objects, then the rest), the number of parts, and the index of the label
     /// record (the label volume with, per code, up to four candidate objects + 1);
     /// `z`, with [`region_flags::COMPANION`]: the record of the region drawn in this
-    /// one's samples; with [`region_flags::INSETS`], the records + 1 of the clip
-    /// windows drawn in place (0: none); `w`: with [`region_flags::SELECTION`], the index of the selection record (the
+    /// one's samples; `w`: with [`region_flags::SELECTION`], the index of the selection record (the
     /// selection volume, its map from the data's voxel index, `lut_a·t + lut_b` the
     /// degree of interest of a normalised sample `t`).
     pub objects: UVec4,
@@ -314,5 +308,20 @@ pub struct GpuSceneInfo {
     pub lut_atlas_width: u32,
     /// Bound on the iterations of every loop along a ray ([`super::pack::march_bound`]).
     pub max_steps: u32,
-    pub pad_b: u32,
+    /// How many of `insets` are in use.
+    pub inset_count: u32,
+    /// The clip windows drawn in their datasets' samples ([`super::pack::insets`]): in
+    /// the uniform buffer, where every SIMD lane reads them alike (on llvmpipe each read
+    /// of a storage buffer at an address taken from another record loaded lane by lane,
+    /// and six planes a window so read cost 5 % of a frame).
+    pub insets: [GpuInset; super::pack::MAX_INSETS],
+}
+
+/// A clip window drawn in place: the six planes of its box (`n·x − d`, negative
+/// inside), the record of the region it is drawn in, and its table in the lookup atlas.
+#[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
+pub struct GpuInset {
+    pub planes: [Vec4; 6],
+    pub host: u32,
+    pub lut_offset: u32,
 }

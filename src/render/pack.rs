@@ -161,10 +161,9 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
             draw_in(&mut out, a, record as usize);
         }
     }
-    for (k, inset) in in_place.iter().enumerate() {
-        let slot = in_place[..k].iter().filter(|i| i.host == inset.host).count();
+    for inset in &in_place {
         if let (Some(host), Some(window)) = (out.region_slots[inset.host], out.region_slots[inset.window]) {
-            draw_in_place(&mut out, host as usize, slot, window as usize);
+            draw_in_place(&mut out, host as usize, window as usize, &prepared[inset.host].region.holes[inset.hole]);
         }
     }
     // Records the ray does not traverse: the parts and labels of segmented regions, the
@@ -182,7 +181,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
     if fused.iter().any(Option::is_some) {
         out.features |= super::gpu_types::features::COMPANION;
     }
-    out.features |= inset_features(&out.regions);
+    out.features |= inset_features(&out.insets);
     if channels.is_some() && out.features & super::gpu_types::features::SELECTION != 0 {
         out.features |= super::gpu_types::features::DOI_CHANNEL;
     }
@@ -548,7 +547,7 @@ pub fn polyhedron_sphere(planes: &[crate::region::Plane]) -> Vec4 {
 mod insets;
 mod packed;
 mod selection;
-pub use insets::{Inset, MAX_INSETS, inset_count, inset_features, insets};
+pub use insets::{Inset, MAX_INSETS, inset_features, insets};
 use insets::{draw_in_place, kept_holes};
 pub use packed::{Atlas, LUT_ATLAS_WIDTH, PackedScene, atlas_layout};
 pub use selection::{companions, constant_bricks, doi_channels};

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use super::extract::ExtractedScene;
 use super::gpu_types::GpuSceneInfo;
-use super::pack::{LUT_ATLAS_WIDTH, PackedScene, pack};
+use super::pack::{LUT_ATLAS_WIDTH, MAX_INSETS, PackedScene, pack};
 use crate::region::RenderScene;
 use crate::volume::{Volume, Voxels};
 
@@ -331,7 +331,8 @@ fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScen
         region_count: packed.region_count,
         lut_atlas_width: LUT_ATLAS_WIDTH,
         max_steps: packed.max_steps,
-        pad_b: 0,
+        inset_count: packed.insets.len().min(MAX_INSETS) as u32,
+        insets: std::array::from_fn(|i| packed.insets.get(i).copied().unwrap_or_default()),
     };
     let mut ub = UniformBuffer::new(Vec::new());
     let _ = ub.write(&info);

@@ -8,9 +8,10 @@
 //! (`windows::regions`). On llvmpipe the lanes of a SIMD group wait at each segment's
 //! end for the group's longest segment, and each segment scans the ray's intervals and
 //! loads its region's record again: one clip window cost ×1.09–1.11 of the frame
-//! without it, for the same samples. In place, the ray has one segment and each sample
-//! chooses its table by two comparisons of its ray parameter with the box's interval
-//! (found once per segment; `shaders/focal/insets.wgsl`).
+//! without it, for the same samples. In place, the ray has one segment, cut into runs
+//! of samples that share a table where it enters and leaves the box
+//! (`shaders/focal/insets.wgsl`). The boxes ride in the scene's uniform buffer
+//! ([`GpuInset`]): at most [`MAX_INSETS`] in a scene.
 //!
 //! The picture is the one the regions give (the CPU reference still draws regions): the
 //! samples lie on the same grid and take the same steps, so only where is a sample's
@@ -20,16 +21,16 @@
 //! `transfer::Lut::for_volume`), so only the table's place in the atlas differs; where
 //! the window's region is exactly the box cut from the dataset's (no clip plane of the
 //! dataset's lies inside the box); and where no third region meets the window's (its
-//! samples would come between the two looks). A region takes at most
-//! [`MAX_INSETS`] windows in place; its empty-space skipping then skips only the bricks
-//! where neither look draws.
+//! samples would come between the two looks). A scene takes at most [`MAX_INSETS`]
+//! windows in place (the others stay regions); a host's empty-space skipping skips only
+//! the bricks where none of its looks draws.
 
-use super::super::gpu_types::{GpuRegion, region_flags};
+use super::super::gpu_types::GpuInset;
 use super::packed::PackedScene;
 use crate::reference::prepare::{PreparedLookup, PreparedRegion};
 use crate::region::{Mode, Plane, meet, vertices};
 
-/// Most windows one region draws in place (slots in `shaders/focal/insets.wgsl`).
+/// Most windows a scene draws in place ([`GpuInset`]s in the scene's uniform buffer).
 pub const MAX_INSETS: usize = 4;
 
 /// One window drawn in place: the region `host`, less its hole `hole`, draws region
@@ -42,7 +43,7 @@ pub struct Inset {
 }
 
 /// The windows of `prepared` that can be drawn in place (module doc), at most
-/// [`MAX_INSETS`] per host; each window and each hole at most once.
+/// [`MAX_INSETS`]; each window and each hole at most once.
 pub fn insets(prepared: &[PreparedRegion]) -> Vec<Inset> {
     let mut out: Vec<Inset> = Vec::new();
     for (w, pw) in prepared.iter().enumerate() {
@@ -55,7 +56,7 @@ pub fn insets(prepared: &[PreparedRegion]) -> Vec<Inset> {
             continue;
         }
         let found = prepared.iter().enumerate().find_map(|(h, ph)| {
-            if h == w || !plain(ph) || !alike(ph, pw) || out.iter().filter(|i| i.host == h).count() >= MAX_INSETS {
+            if h == w || !plain(ph) || !alike(ph, pw) || out.len() >= MAX_INSETS {
                 return None;
             }
             let hole = ph.region.holes.iter().position(|box_| fills(&ph.region.planes, box_, &pw.region.planes, &corners))?;
@@ -104,11 +105,15 @@ fn fills(host: &[Plane], hole: &[Plane; 6], window: &[Plane], corners: &[glam::V
     !cut_corners.is_empty() && corners.iter().all(|&p| within(host, p) && within(hole, p)) && cut_corners.iter().all(|&p| within(window, p))
 }
 
-/// Draws the window record `window` in place in region `host` (slot `slot`): `host`
-/// names it (`objects`, record + 1) and skips only the bricks where neither draws.
-pub(super) fn draw_in_place(out: &mut PackedScene, host: usize, slot: usize, window: usize) {
-    out.regions[host].flags |= region_flags::INSETS;
-    out.regions[host].objects[slot] = window as u32 + 1;
+/// Draws the window record `window` in place in region record `host`, inside `hole`
+/// (the box the window fills): the window's box and table go to the scene's insets,
+/// and `host` skips only the bricks where neither draws.
+pub(super) fn draw_in_place(out: &mut PackedScene, host: usize, window: usize, hole: &[Plane; 6]) {
+    out.insets.push(GpuInset {
+        planes: hole.map(|pl| pl.normal.extend(pl.offset)),
+        host: host as u32,
+        lut_offset: out.regions[window].lut_offset,
+    });
     super::selection::merge_occupancy(out, host, window);
 }
 
@@ -124,23 +129,9 @@ pub fn kept_holes(prepared: &[PreparedRegion], insets: &[Inset]) -> Vec<Vec<[Pla
         .collect()
 }
 
-/// How many windows region record `r` draws in place.
-pub fn inset_count(r: &GpuRegion) -> usize {
-    if r.flags & region_flags::INSETS == 0 {
-        return 0;
-    }
-    r.objects.to_array().iter().filter(|&&i| i != 0).count()
-}
-
-/// The shader features of windows drawn in place among `regions`: one slot per host, or
-/// [`MAX_INSETS`] where some host draws more than one.
-pub fn inset_features(regions: &[GpuRegion]) -> u32 {
-    use super::super::gpu_types::features;
-    match regions.iter().map(inset_count).max().unwrap_or(0) {
-        0 => 0,
-        1 => features::INSETS,
-        _ => features::INSETS | features::MANY_INSETS,
-    }
+/// The shader features of the windows drawn in place, `insets`.
+pub fn inset_features(insets: &[GpuInset]) -> u32 {
+    if insets.is_empty() { 0 } else { super::super::gpu_types::features::INSETS }
 }
 
 #[cfg(test)]
@@ -149,10 +140,10 @@ mod tests {
 
     use glam::{Affine3A, Vec3};
 
-    use super::super::super::gpu_types::features;
+    use super::super::super::gpu_types::{GpuRegion, features};
     use super::super::pack;
     use super::*;
-    use crate::region::{Appearance, RenderScene};
+    use crate::region::{Appearance, Region, RenderScene};
     use crate::transfer::presets;
     use crate::volume::phantom;
     use crate::windows::boxes::OrientedBox;
@@ -188,27 +179,47 @@ mod tests {
         let s = scene(&FOUR[..1], &bone);
         assert_eq!(s.regions[0].holes.len(), 1, "the window cuts its box out of the dataset as regions");
         let packed = pack(&s, 2048).unwrap();
-        // One region the ray traverses, without its hole, naming the window's record
-        // (after it: record 1, + 1), whose table differs from its own.
+        // One region the ray traverses, without its hole; the window's box and table
+        // (not its own) in the scene's insets, naming the host.
         assert_eq!(packed.region_count, 1);
         let (host, window) = (packed.regions[0], packed.regions[1]);
         assert_eq!(host.hole_count, 0);
-        assert_eq!((host.flags & region_flags::INSETS, host.objects.to_array()), (region_flags::INSETS, [2, 0, 0, 0]));
+        let box_ = s.regions[0].holes[0].map(|pl| pl.normal.extend(pl.offset));
+        assert_eq!(packed.insets, vec![GpuInset { planes: box_, host: 0, lut_offset: window.lut_offset }]);
         assert_ne!(host.lut_offset, window.lut_offset);
         assert_eq!((host.lut_width, host.lut_a, host.lut_b), (window.lut_width, window.lut_a, window.lut_b));
-        assert_eq!(packed.features & (features::INSETS | features::MANY_INSETS | features::HOLES), features::INSETS);
+        assert_eq!(packed.features & (features::INSETS | features::HOLES), features::INSETS);
         // It skips only bricks where neither look draws.
         let words = |r: &GpuRegion| packed.occupancy[r.occupancy_offset as usize..][..3 * 8usize.div_ceil(32)].to_vec();
         assert!(words(&host).iter().zip(words(&window)).all(|(h, w)| h & w == w));
-        // Four windows: four slots.
+        // Four windows: four insets, each its own box.
         let packed = pack(&scene(&FOUR, &bone), 2048).unwrap();
-        assert_eq!(packed.region_count, 1);
-        assert_eq!(packed.regions[0].objects.to_array(), [2, 3, 4, 5]);
-        assert_eq!(inset_count(&packed.regions[0]), 4);
-        assert_eq!(
-            packed.features & (features::INSETS | features::MANY_INSETS | features::HOLES),
-            features::INSETS | features::MANY_INSETS
-        );
+        assert_eq!((packed.region_count, packed.insets.len()), (1, 4));
+        assert!(packed.insets.iter().all(|i| i.host == 0));
+        assert!((1..4).all(|k| packed.insets[k].planes != packed.insets[0].planes));
+    }
+
+    #[test]
+    fn each_dataset_draws_its_own_windows_in_place() {
+        // Two datasets side by side (the second 40 mm along x), a window into each.
+        let v = Arc::new(phantom::sphere(32, 10.0).unwrap());
+        let beside = Affine3A::from_translation(Vec3::new(40.0, 0.0, 0.0));
+        let mut s = RenderScene::single(v.clone(), look("grayscale_ramp"));
+        s.regions.push(Region::volume_box_at(&v.grid, beside, 0, 0));
+        let window = |at: Vec3, dataset_to_world: Affine3A| {
+            let b = OrientedBox::aligned(at - 4.0, at + 4.0);
+            let content = PlacedContent { volume: v.clone(), volume_index: 0, dataset_to_world, appearance: look("ct_bone") };
+            PlacedWindow { window: b, source: b, fit: None, clip: true, contents: vec![content] }
+        };
+        add_windows(&mut s, 2, &[window(FOUR[0], Affine3A::IDENTITY), window(FOUR[1] + Vec3::new(40.0, 0.0, 0.0), beside)]);
+        let packed = pack(&s, 2048).unwrap();
+        assert_eq!(packed.region_count, 2);
+        assert_eq!(packed.insets.iter().map(|i| i.host).collect::<Vec<_>>(), vec![0, 1]);
+        assert!(packed.regions[..2].iter().all(|r| r.hole_count == 0));
+        // Each inset is its own dataset's hole.
+        for (k, inset) in packed.insets.iter().enumerate() {
+            assert_eq!(inset.planes, s.regions[k].holes[0].map(|pl| pl.normal.extend(pl.offset)));
+        }
     }
 
     #[test]
@@ -220,7 +231,7 @@ mod tests {
             assert!(packed.regions[0].hole_count > 0, "{why}");
             assert_eq!(packed.region_count as usize, s.regions.len(), "{why}");
         };
-        // A fifth window on one region: four in place, the fifth a hole.
+        // A fifth window in the scene: four in place, the fifth a hole.
         let mut five = FOUR.to_vec();
         five.push(Vec3::new(0.0, 0.0, 12.0));
         let packed = pack(&scene(&five, &bone), 2048).unwrap();

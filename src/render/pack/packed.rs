@@ -40,6 +40,8 @@ pub struct PackedScene {
     /// are records: the regions drawn in others' samples ([`crate::render::pack::companions`]), the parts and
     /// labels of segmentations, the selections of weights).
     pub region_count: u32,
+    /// The clip windows drawn in their hosts' samples ([`crate::render::pack::insets`]).
+    pub insets: Vec<crate::render::gpu_types::GpuInset>,
     /// Shader features the regions need ([`crate::render::gpu_types::features`]).
     pub features: u32,
     /// Bound on the iterations of the ray caster's loops ([`crate::render::pack::march_bound`]).
