@@ -90,7 +90,7 @@ struct SceneInfo {
     insets: array<Inset, MAX_INSETS>,
 }
 
-// (render::pack::MAX_INSETS)
+// (render::gpu_types::MAX_INSETS)
 const MAX_INSETS: u32 = 4u;
 
 // A clip window drawn in place: its box's planes (n·x − d, negative inside), the

@@ -314,8 +314,12 @@ pub struct GpuSceneInfo {
     /// the uniform buffer, where every SIMD lane reads them alike (on llvmpipe each read
     /// of a storage buffer at an address taken from another record loaded lane by lane,
     /// and six planes a window so read cost 5 % of a frame).
-    pub insets: [GpuInset; super::pack::MAX_INSETS],
+    pub insets: [GpuInset; MAX_INSETS],
 }
+
+/// Most clip windows a scene draws in place (`render::pack::insets`; `MAX_INSETS` in
+/// `shaders/focal/types.wgsl`).
+pub const MAX_INSETS: usize = 4;
 
 /// A clip window drawn in place: the six planes of its box (`n·x − d`, negative
 /// inside), the record of the region it is drawn in, and its table in the lookup atlas.

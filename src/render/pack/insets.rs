@@ -26,12 +26,10 @@
 //! the bricks where none of its looks draws.
 
 use super::super::gpu_types::GpuInset;
+pub use super::super::gpu_types::MAX_INSETS;
 use super::packed::PackedScene;
 use crate::reference::prepare::{PreparedLookup, PreparedRegion};
 use crate::region::{Mode, Plane, meet, vertices};
-
-/// Most windows a scene draws in place ([`GpuInset`]s in the scene's uniform buffer).
-pub const MAX_INSETS: usize = 4;
 
 /// One window drawn in place: the region `host`, less its hole `hole`, draws region
 /// `window`'s look inside that hole.
