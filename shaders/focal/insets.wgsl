@@ -20,9 +20,9 @@
 #import focal::bindings::scene
 #import focal::regions::cut_by_plane
 
-// The current region's windows on this ray, one in each component (render::pack::
-// MAX_INSETS): the ray's interval in each (empty where none) and the window's table
-// offset in the lookup atlas. (Vectors read at constant components: registers.)
+// The current region's windows on this ray, one in each component (MAX_INSETS): the
+// ray's interval in each (empty where none) and the window's table offset in the
+// lookup atlas. (Vectors read at constant components: registers.)
 struct Insets {
     enter: vec4<f32>,
     leave: vec4<f32>,

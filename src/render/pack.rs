@@ -415,9 +415,9 @@ pub fn reads_mips(r: &GpuRegion) -> bool {
 /// `holes`: the region's holes left after [`insets`] took theirs.
 fn pack_region(p: &PreparedRegion, holes: &[[Plane; 6]], levels: &[UVec3], brick_offset: UVec3, out: &mut PackedScene) -> GpuRegion {
     let plane_offset = out.planes.len() as u32;
-    out.planes.extend(p.region.planes.iter().map(|pl| pl.normal.extend(pl.offset)));
+    out.planes.extend(p.region.planes.iter().map(gpu_plane));
     let hole_offset = out.planes.len() as u32;
-    out.planes.extend(holes.iter().flatten().map(|pl| pl.normal.extend(pl.offset)));
+    out.planes.extend(holes.iter().flatten().map(gpu_plane));
     let lut_offset = out.lut.len() as u32;
     let mut flags = 0;
     let (lut_a, lut_b, lut_width, labels) = match &p.lookup {
@@ -549,7 +549,7 @@ mod packed;
 mod selection;
 pub use insets::{Inset, MAX_INSETS, inset_features, insets};
 use insets::{draw_in_place, kept_holes};
-pub use packed::{Atlas, LUT_ATLAS_WIDTH, PackedScene, atlas_layout};
+pub use packed::{Atlas, LUT_ATLAS_WIDTH, PackedScene, atlas_layout, gpu_plane};
 pub use selection::{companions, constant_bricks, doi_channels};
 use selection::{draw_in, pack_selection};
 

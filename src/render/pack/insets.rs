@@ -108,7 +108,7 @@ fn fills(host: &[Plane], hole: &[Plane; 6], window: &[Plane], corners: &[glam::V
 /// and `host` skips only the bricks where neither draws.
 pub(super) fn draw_in_place(out: &mut PackedScene, host: usize, window: usize, hole: &[Plane; 6]) {
     out.insets.push(GpuInset {
-        planes: hole.map(|pl| pl.normal.extend(pl.offset)),
+        planes: hole.map(|pl| super::packed::gpu_plane(&pl)),
         host: host as u32,
         lut_offset: out.regions[window].lut_offset,
     });
@@ -182,7 +182,7 @@ mod tests {
         assert_eq!(packed.region_count, 1);
         let (host, window) = (packed.regions[0], packed.regions[1]);
         assert_eq!(host.hole_count, 0);
-        let box_ = s.regions[0].holes[0].map(|pl| pl.normal.extend(pl.offset));
+        let box_ = s.regions[0].holes[0].map(|pl| super::super::packed::gpu_plane(&pl));
         assert_eq!(packed.insets, vec![GpuInset { planes: box_, host: 0, lut_offset: window.lut_offset }]);
         assert_ne!(host.lut_offset, window.lut_offset);
         assert_eq!((host.lut_width, host.lut_a, host.lut_b), (window.lut_width, window.lut_a, window.lut_b));
@@ -216,7 +216,7 @@ mod tests {
         assert!(packed.regions[..2].iter().all(|r| r.hole_count == 0));
         // Each inset is its own dataset's hole.
         for (k, inset) in packed.insets.iter().enumerate() {
-            assert_eq!(inset.planes, s.regions[k].holes[0].map(|pl| pl.normal.extend(pl.offset)));
+            assert_eq!(inset.planes, s.regions[k].holes[0].map(|pl| super::super::packed::gpu_plane(&pl)));
         }
     }
 

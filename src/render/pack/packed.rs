@@ -87,3 +87,8 @@ impl PackedScene {
         (self.lut.len() as u32).div_ceil(LUT_ATLAS_WIDTH).max(1)
     }
 }
+
+/// A plane as the shader reads it: `(n, d)`, `n·x − d` negative inside.
+pub fn gpu_plane(pl: &crate::region::Plane) -> Vec4 {
+    pl.normal.extend(pl.offset)
+}
