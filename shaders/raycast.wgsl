@@ -611,7 +611,7 @@ fn dvr_run(r: Region, g: Segment, kk_in: f32, k_end: f32, ratio: f32, ray: Ray, 
             // (Up to k_last the samples lie in q's brick or sub-block, as looked up.)
             c = dvr_classify_at(r, q, true, look(r, g, kk));
         }
-        acc = dvr_classified(r, q, c.v, c.rgba, c.weight, ratio, ray, segment_t(g, kk), acc, true);
+        acc = dvr_classified(r, q, c, ratio, ray, segment_t(g, kk), acc, true);
         kk += 1.0;
     }
     return acc;

@@ -10,7 +10,7 @@
 #import focal::camera::Ray
 #import focal::regions::to_voxel
 #import focal::sampling::{trilinear, trilinear_at, trilinear_with_doi, nearest_code, index_gradient, index_gradient_at, gradient_norm, count_sample}
-#import focal::transfer::{classify, classify_label, classify_lambda, correct_opacity, filtered, filtered_table}
+#import focal::transfer::{classify, classify_label, classify_lambda, correct_opacity, filtered, filtered_looks}
 #import focal::shading::{shade, shade_with, blinn_phong}
 #import focal::context::{context_opacity, eye_distance}
 #import focal::compositing::composite
@@ -44,26 +44,28 @@ fn value_at(r: Region, q: vec3<f32>, vd: vec2<f32>, located: bool) -> f32 {
 // t, composited under acc, weighted by the current selection weight. The gradient is
 // fetched once for shading and modulation.
 fn dvr_sample(r: Region, q: vec3<f32>, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>) -> vec4<f32> {
-    let c = dvr_classify(r, q);
-    return dvr_classified(r, q, c.v, c.rgba, c.weight, ratio, ray, t, acc, true);
+    return dvr_classified(r, q, dvr_classify(r, q), ratio, ray, t, acc, true);
 }
 
-// A DVR sample classified: its value (0 for labels), colour and opacity, and the
-// selection's weight of that opacity.
+// A DVR sample classified: its value (0 for labels), colour and opacity, the
+// selection's weight of that opacity, and (with COMPANION) the colour and opacity of
+// the current companion's look at the same value, before its weight.
 struct Classified {
     v: f32,
     rgba: vec4<f32>,
     weight: f32,
+    other: vec4<f32>,
 }
 
-// Whether a classified sample can add anything to the ray (with a companion look, any
-// sample may).
+// A sample of value v and colour rgba that no selection weighs and no companion shares.
+fn classified(v: f32, rgba: vec4<f32>) -> Classified {
+    return Classified(v, rgba, 1.0, vec4(0.0));
+}
+
+// Whether a classified sample can add anything to the ray (the companion's look left
+// out of account where the ray is outside it: a sample too many is only classified).
 fn adds_something(c: Classified) -> bool {
-#ifdef COMPANION
-    return true;
-#else
-    return c.rgba.a * c.weight > 0.0;
-#endif
+    return c.rgba.a * c.weight > 0.0 || c.other.a * (1.0 - c.weight) > 0.0;
 }
 
 // The first half of dvr_sample: the sample at q classified.
@@ -81,6 +83,7 @@ fn dvr_classify_at(r: Region, q: vec3<f32>, located: bool, lut: u32) -> Classifi
     var v = 0.0;
     // The value and the selection's sample, in one fetch with DOI_CHANNEL (labels or not).
     var vd = vec2(0.0);
+    var other = vec4(0.0);
 #ifdef DOI_CHANNEL
     vd = trilinear_with_doi(r, q);
 #endif
@@ -89,34 +92,48 @@ fn dvr_classify_at(r: Region, q: vec3<f32>, located: bool, lut: u32) -> Classifi
         rgba = classify_label(r, nearest_code(r, q), scene.lut_atlas_width);
     } else {
         v = value_at(r, q, vd, located);
-        rgba = filtered(r, lut, v, scene.lut_atlas_width);
+        rgba = classify_at(r, lut, v, &other);
     }
 #else
     v = value_at(r, q, vd, located);
-    rgba = filtered(r, lut, v, scene.lut_atlas_width);
+    rgba = classify_at(r, lut, v, &other);
 #endif
     var w = 1.0;
 #ifdef HAS_SELECTION
     w = weight_at(q, vd.y);
 #endif
-    return Classified(v, rgba, w);
+    return Classified(v, rgba, w, other);
 }
 
-// dvr_sample after classification: value v (0 for labels) gave rgba, whose opacity
-// takes `weight` (1 for segmented regions' parts). With COMPANION the current
-// companion region's look follows at the same voxel, where the ray is inside it, with
-// the 1 − weight left over (render::pack::companions: the same volume under the same
-// map, a DVR look with the same shading, so it shares the gradient and the Blinn-Phong
-// terms; on llvmpipe a second shading of its own cost a third of the frame).
+// Value v through table `lut` of region r; with a companion, r's own look and (in
+// `other`) the companion's, both from their pair table (companion.table).
+fn classify_at(r: Region, lut: u32, v: f32, other: ptr<function, vec4<f32>>) -> vec4<f32> {
+#ifdef COMPANION
+    let looks = filtered_looks(select(lut, companion.table, companion.on), r.lut_width, r.lut_a, r.lut_b, v, scene.lut_atlas_width, companion.on);
+    *other = looks.second;
+    return looks.first;
+#else
+    return filtered(r, lut, v, scene.lut_atlas_width);
+#endif
+}
+
+// dvr_sample after classification: the sample's value (0 for labels) gave its colour,
+// whose opacity takes its weight (1 for segmented regions' parts). With COMPANION the
+// current companion region's look (classified with it) follows at the same voxel,
+// where the ray is inside it, with the 1 − weight left over (render::pack::companions:
+// the same volume under the same map, a DVR look with the same shading, so it shares
+// the gradient and the Blinn-Phong terms; on llvmpipe a second shading of its own cost
+// a third of the frame).
 // `located` (a literal): the last page look-up was of q, as after dvr_classify
 // (sampling::index_gradient_at).
-fn dvr_classified(r: Region, q: vec3<f32>, v: f32, rgba: vec4<f32>, weight: f32, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>, located: bool) -> vec4<f32> {
-    let a = rgba.a * weight;
+fn dvr_classified(r: Region, q: vec3<f32>, sample: Classified, ratio: f32, ray: Ray, t: f32, acc: vec4<f32>, located: bool) -> vec4<f32> {
+    let v = sample.v;
+    let rgba = sample.rgba;
+    let a = rgba.a * sample.weight;
     var other = vec4(0.0);
 #ifdef COMPANION
-    if companion.on && weight < 1.0 && t >= companion.t_enter && t <= companion.t_leave {
-        other = filtered_table(companion.lut_offset, companion.lut_width, companion.lut_ab.x, companion.lut_ab.y, v, scene.lut_atlas_width);
-        other.a *= 1.0 - weight;
+    if companion.on && t >= companion.t_enter && t <= companion.t_leave {
+        other = vec4(sample.other.rgb, sample.other.a * (1.0 - sample.weight));
     }
 #endif
     if a <= 0.0 && other.a <= 0.0 {

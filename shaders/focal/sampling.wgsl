@@ -179,8 +179,14 @@ fn nearest_code(r: Region, q: vec3<f32>) -> u32 {
 #endif
 }
 
-fn lut_texel(index: u32, atlas_width: u32) -> vec4<f32> {
+// Texel `index` of the lookup-table atlas, rows of atlas_width: its bits, and the f32
+// colour they hold in every table but a pair table.
+fn lut_bits(index: u32, atlas_width: u32) -> vec4<u32> {
     return textureLoad(lut_atlas, vec2<i32>(i32(index % atlas_width), i32(index / atlas_width)), 0);
+}
+
+fn lut_texel(index: u32, atlas_width: u32) -> vec4<f32> {
+    return bitcast<vec4<f32>>(lut_bits(index, atlas_width));
 }
 
 fn label_alpha(r: Region, q: vec3<f32>, atlas_width: u32) -> f32 {

@@ -64,10 +64,9 @@ fn set_weight(w: Weight) {
 // weight. What its samples need of its record, not the record: on llvmpipe a record in
 // a private variable cost a third of the frame.
 struct Companion {
-    // Its lookup table: atlas offset, texel count, and a, b of a·t + b.
-    lut_offset: u32,
-    lut_width: u32,
-    lut_ab: vec2<f32>,
+    // The pair table of both looks (render::pack::pair_table; the current region's
+    // width and a·t + b).
+    table: u32,
     // Its opacity-correction ratio for the march step.
     ratio: f32,
     // The ray's interval inside it: outside, the region adds nothing. (naga_oil
@@ -88,9 +87,7 @@ fn set_companion(r: Region, origin: vec3<f32>, dir: vec3<f32>, step: f32) {
         let iv = region_interval(c, origin, dir);
         companion.t_enter = max(iv.x, 0.0);
         companion.t_leave = iv.y;
-        companion.lut_offset = c.lut_offset;
-        companion.lut_width = c.lut_width;
-        companion.lut_ab = vec2(c.lut_a, c.lut_b);
+        companion.table = r.objects.y;
         companion.ratio = c.native_step / (world_step(c, dir) * c.reference_length) * step;
     }
 }

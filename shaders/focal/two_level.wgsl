@@ -15,7 +15,7 @@
 #import focal::transfer::classify
 #import focal::compositing::composite
 #import focal::segments::{DONE, HAS_PREV}
-#import focal::samples::{is_projection, projected, dvr_classified, iso_surface, iso_hit, projection_takes}
+#import focal::samples::{is_projection, projected, dvr_classified, classified, iso_surface, iso_hit, projection_takes}
 
 #ifdef HAS_TWO_LEVEL
 // Two-level rendering (src/region/appearance.rs): the segment of a segmented region the ray is in
@@ -221,7 +221,7 @@ fn two_level_sample(r: Region, labels: Region, part: ptr<function, Region>, open
 #endif
 #ifdef HAS_DVR
     let own = own_value(r, labels, q, v);
-    out = dvr_classified(*part, q, own, classify(*part, own, scene.lut_atlas_width), 1.0, ratio, ray, t, out, false);
+    out = dvr_classified(*part, q, classified(own, classify(*part, own, scene.lut_atlas_width)), ratio, ray, t, out, false);
 #endif
     return out;
 }

@@ -122,7 +122,8 @@ const REGION_LAMBDA: u32 = 8u;
 // Opacity weighted by a selection (record: objects.w); KEEP_UNSELECTED: by 1 − doi.
 const REGION_SELECTION: u32 = 16u;
 const REGION_KEEP_UNSELECTED: u32 = 32u;
-// Another region is drawn in this one's samples (record: objects.z; render::pack::companions).
+// Another region is drawn in this one's samples (record: objects.z; the pair table of
+// both looks: objects.y; render::pack::companions, render::pack::pair_table).
 const REGION_COMPANION: u32 = 64u;
 // A segmented region whose labels lie on its data's grid (two_level::own_value).
 const REGION_ON_GRID: u32 = 128u;

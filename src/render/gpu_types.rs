@@ -42,8 +42,8 @@ pub mod region_flags {
     pub const SELECTION: u32 = 16;
     /// With [`SELECTION`]: weighted by 1 − the degree of interest.
     pub const KEEP_UNSELECTED: u32 = 32;
-    /// Another region is drawn in this one's samples (its record: `objects.z`;
-    /// `render::pack::companions`).
+    /// Another region is drawn in this one's samples (its record: `objects.z`; both
+    /// looks' pair table: `objects.y`; `render::pack::companions`).
     pub const COMPANION: u32 = 64;
     /// A segmented region whose label volume lies on its data's grid: each part's
     /// samples come from its own label's voxels (`two_level.wgsl` own_value).
@@ -215,8 +215,9 @@ pub struct GpuRegion {
     /// Segmented regions ([`mode::TWO_LEVEL`]): index of the first part record (the
     /// objects, then the rest), the number of parts, and the index of the label
     /// record (the label volume with, per code, up to four candidate objects + 1);
-    /// `z`, with [`region_flags::COMPANION`]: the record of the region drawn in this
-    /// one's samples; `w`: with [`region_flags::SELECTION`], the index of the selection record (the
+    /// with [`region_flags::COMPANION`] (no objects), `y`: the offset of the pair table
+    /// of both looks (`render::pack::pair_table`), `z`: the record of the region drawn
+    /// in this one's samples; `w`: with [`region_flags::SELECTION`], the index of the selection record (the
     /// selection volume, its map from the data's voxel index, `lut_a·t + lut_b` the
     /// degree of interest of a normalised sample `t`).
     pub objects: UVec4,

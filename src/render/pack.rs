@@ -550,7 +550,7 @@ mod selection;
 pub use insets::{Inset, MAX_INSETS, inset_features, insets};
 use insets::{draw_in_place, kept_holes};
 pub use packed::{Atlas, LUT_ATLAS_WIDTH, PackedScene, atlas_layout, gpu_plane};
-pub use selection::{companions, constant_bricks, doi_channels};
+pub use selection::{companions, constant_bricks, doi_channels, pair_table, unorm_pair};
 use selection::{draw_in, pack_selection};
 
 #[cfg(test)]

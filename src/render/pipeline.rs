@@ -34,7 +34,9 @@ pub fn init_pipeline(mut commands: Commands, device: Res<RenderDevice>, fullscre
                 storage_buffer_read_only_sized(false, None),
                 storage_buffer_read_only_sized(false, None),
                 storage_buffer_read_only_sized(false, None),
-                texture_2d(float(false)),
+                // (The lookup tables' bits: f32 colours, or half-float pairs of two
+                // looks; render::pack::pair_table.)
+                texture_2d(TextureSampleType::Uint),
                 texture_3d(float(true)),
                 texture_3d(TextureSampleType::Uint),
                 sampler(SamplerBindingType::Filtering),

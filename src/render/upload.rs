@@ -355,7 +355,7 @@ fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScen
             mip_level_count: 1,
             sample_count: 1,
             dimension: TextureDimension::D2,
-            format: TextureFormat::Rgba32Float,
+            format: TextureFormat::Rgba32Uint,
             usage: TextureUsages::TEXTURE_BINDING | TextureUsages::COPY_DST,
             view_formats: &[],
         },

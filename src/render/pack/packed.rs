@@ -14,7 +14,9 @@ pub struct PackedScene {
     pub regions: Vec<GpuRegion>,
     /// Plane `(normal, offset)` per entry; regions index ranges of it.
     pub planes: Vec<Vec4>,
-    /// RGBA texels, `LUT_ATLAS_WIDTH` per row, rows stacked.
+    /// RGBA texels, `LUT_ATLAS_WIDTH` per row, rows stacked: `f32` colours, and the
+    /// pair tables' half floats carried as the bits of `f32`s
+    /// ([`crate::render::pack::pair_table`]); the GPU reads the bits.
     pub lut: Vec<[f32; 4]>,
     /// Occupancy bits (bit `i % 32` of word `i / 32` is brick `i`).
     pub occupancy: Vec<u32>,

@@ -37,11 +37,41 @@ pub fn doi_channels(prepared: &[PreparedRegion], all: &[std::sync::Arc<crate::vo
 }
 
 /// Draws region record `b` in the samples of region `a` ([`companions`]): `a` names it
-/// (`objects.z`) and skips only the bricks where neither draws.
+/// (`objects.z`) and the pair table of both looks (`objects.y`, [`pair_table`]), and
+/// skips only the bricks where neither draws.
 pub(super) fn draw_in(out: &mut PackedScene, a: usize, b: usize) {
     out.regions[a].flags |= region_flags::COMPANION;
+    out.regions[a].objects.y = pair_table(out, a, b);
     out.regions[a].objects.z = b as u32;
     merge_occupancy(out, a, b);
+}
+
+/// Appends the pair table of region records `a` and `b`, whose tables map a sample
+/// alike (two looks of one volume: [`companions`]), and returns its offset: texel `i`
+/// holds both looks' colours at texel `i` of their own tables as 16-bit normalised
+/// numbers ([`unorm_pair`]), so that one filtered lookup classifies a sample under both
+/// (`transfer.wgsl` filtered_looks). Each channel is off by at most 1/131070 (half
+/// floats would keep more of a faint opacity but less of a nearly opaque one, whose
+/// transparency the opacity correction raises to a power, and need a shader capability
+/// that llvmpipe grants only with f16).
+pub fn pair_table(out: &mut PackedScene, a: usize, b: usize) -> u32 {
+    let (ra, rb) = (out.regions[a], out.regions[b]);
+    let offset = out.lut.len() as u32;
+    for i in 0..ra.lut_width.min(rb.lut_width) {
+        let texel = unorm_pair(out.lut[(ra.lut_offset + i) as usize], out.lut[(rb.lut_offset + i) as usize]);
+        out.lut.push(texel);
+    }
+    offset
+}
+
+/// A pair table's texel: `first`'s colour then `second`'s (channels in 0…1), two
+/// 16-bit normalised numbers to each 32 bits, the first in the lower half (WGSL's
+/// pack2x16unorm: ⌊0.5 + 65535·x⌋), carried as the bits of `f32`s (the atlas holds
+/// bits, [`crate::render::pack::PackedScene::lut`]; only arithmetic could change a NaN's).
+pub fn unorm_pair(first: [f32; 4], second: [f32; 4]) -> [f32; 4] {
+    let bits = |x: f32| (0.5 + 65535.0 * x.clamp(0.0, 1.0)).floor() as u32;
+    let two = |lo: f32, hi: f32| f32::from_bits(bits(lo) | bits(hi) << 16);
+    [two(first[0], first[1]), two(first[2], first[3]), two(second[0], second[1]), two(second[2], second[3])]
 }
 
 /// Region `a`, which draws region `b`'s look in its samples, skips only the bricks
@@ -128,7 +158,8 @@ pub fn constant_bricks(bricks: &crate::volume::BrickGrid, full: u16) -> Vec<u32>
 /// a sample on their common face without `b`), neither has holes or objects, `b` is
 /// plain DVR shaded as `a` is (it shares `a`'s gradient and Blinn-Phong terms) and
 /// steps no finer than `a` (the ray's step is the finest of the regions it crosses, and
-/// `b` no longer counts). Per region: the one drawn in its samples.
+/// `b` no longer counts), and both tables map a sample alike, with channels in 0…1 (one
+/// [`pair_table`] holds both looks; tables of one volume map alike). Per region: the one drawn in its samples.
 pub fn companions(prepared: &[PreparedRegion], carried: bool) -> Vec<Option<usize>> {
     use crate::region::{Keep, vertices};
     let n = prepared.len();
@@ -155,6 +186,15 @@ pub fn companions(prepared: &[PreparedRegion], carried: bool) -> Vec<Option<usiz
             |pa: &PreparedRegion| pa.shading.enabled == pb.shading.enabled && (!pb.shading.enabled || pa.shading == pb.shading);
         let inside =
             |pa: &PreparedRegion| corners.iter().all(|p| pa.region.planes.iter().all(|pl| pl.distance(*p) <= 1e-4 * (1.0 + p.length())));
+        // (One pair table serves both: their tables map a sample alike, and their
+        // channels lie in 0…1.)
+        let unit = |lut: &crate::transfer::Lut| lut.rgba.iter().flatten().all(|c| (0.0..=1.0).contains(c));
+        let tables_alike = |pa: &PreparedRegion| match (&pa.lookup, &pb.lookup) {
+            (PreparedLookup::Transfer { lut: la, a: aa, b: ba }, PreparedLookup::Transfer { lut: lb, a: ab, b: bb }) => {
+                la.rgba.len() == lb.rgba.len() && aa == ab && ba == bb && unit(la) && unit(lb)
+            }
+            _ => false,
+        };
         let host = (0..b).find(|&a| {
             let pa = &prepared[a];
             out[a].is_none()
@@ -165,6 +205,7 @@ pub fn companions(prepared: &[PreparedRegion], carried: bool) -> Vec<Option<usiz
                 && pa.region.world_to_voxel.abs_diff_eq(pb.region.world_to_voxel, 1e-5)
                 && inside(pa)
                 && shaded_alike(pa)
+                && tables_alike(pa)
                 && pb.native_step >= pa.native_step
         });
         let Some(a) = host else { continue };

@@ -296,6 +296,35 @@ fn a_selection_on_its_datas_grid_rides_in_the_second_channel() {
     assert_eq!((packed.regions[0].flags & region_flags::COMPANION, packed.regions[0].objects.z), (region_flags::COMPANION, 1));
     assert_eq!(packed.features & (features::COMPANION | features::DVR_PAIRS | features::MULTI_REGION), features::COMPANION);
     assert_eq!(packed.region_slots, vec![Some(0), Some(1)]);
+    // One lookup classifies a sample under both looks: the pair table holds, at each
+    // texel, the data's colour and the selection's, as 16-bit normalised numbers.
+    let (host, drawn) = (packed.regions[0], packed.regions[1]);
+    assert_eq!((host.lut_width, host.lut_a, host.lut_b), (drawn.lut_width, drawn.lut_a, drawn.lut_b));
+    let pair = host.objects.y as usize;
+    assert!(pair >= (drawn.lut_offset + drawn.lut_width) as usize);
+    let unorm = |bits: u32| (bits & 0xFFFF) as f32 / 65535.0;
+    for i in 0..host.lut_width as usize {
+        let bits = packed.lut[pair + i].map(f32::to_bits);
+        let looks = [unorm(bits[0]), unorm(bits[0] >> 16), unorm(bits[1]), unorm(bits[1] >> 16)];
+        let others = [unorm(bits[2]), unorm(bits[2] >> 16), unorm(bits[3]), unorm(bits[3] >> 16)];
+        for (decoded, table) in [(looks, host.lut_offset as usize), (others, drawn.lut_offset as usize)] {
+            let texel = packed.lut[table + i];
+            assert!(decoded.iter().zip(texel).all(|(d, t)| (d - t).abs() <= 0.5 / 65535.0 + 1e-7), "texel {i}: {decoded:?} {texel:?}");
+        }
+    }
+    // (Tables that map a sample otherwise, or hold a channel beyond 1, could share no
+    // pair table: not drawn in.)
+    let scene = scene_with(&on_grid, &on_grid);
+    let prepared = || crate::reference::prepare(&scene).unwrap();
+    assert_eq!(companions(&prepared(), true), vec![Some(1), None]);
+    let (mut mapped, mut bright) = (prepared(), prepared());
+    if let PreparedLookup::Transfer { a, .. } = &mut mapped[1].lookup {
+        *a *= 2.0;
+    }
+    if let PreparedLookup::Transfer { lut, .. } = &mut bright[0].lookup {
+        lut.rgba[7][0] = 1.5;
+    }
+    assert_eq!((companions(&mapped, true), companions(&bright, true)), (vec![None, None], vec![None, None]));
     let words = |r: &GpuRegion| &packed.occupancy[r.occupancy_offset as usize..][..v.bricks().len().div_ceil(32)];
     assert!(words(&packed.regions[0]).iter().zip(words(&packed.regions[1])).all(|(a, b)| a & b == *b));
     // Inside it but shifted by a voxel, it samples other voxels: a region of its own,
@@ -329,6 +358,15 @@ fn a_selection_on_its_datas_grid_rides_in_the_second_channel() {
     // No weights, no channel.
     let plain = RenderScene::single(v.clone(), Appearance::new(Mode::Dvr, presets::builtin("grayscale_ramp").unwrap()));
     assert_eq!(pack(&plain, 2048).unwrap().doi_channels, vec![None]);
+}
+
+#[test]
+fn a_pair_texel_holds_two_colours_as_16_bit_normalised_numbers() {
+    // Worked by hand, ⌊0.5 + 65535·x⌋: 1 → 0xFFFF, 0.5 → 32768 = 0x8000, 0.25 → 16384 =
+    // 0x4000, 0 → 0, 0.75 → 49151 = 0xBFFF, 0.001 → ⌊66.035⌋ = 0x42; out of 0…1
+    // clamped; the first of each two in the lower 16 bits (WGSL's unpack2x16unorm).
+    let texel = unorm_pair([1.0, 0.5, 0.25, 0.0], [0.75, 1.5, -0.5, 0.001]);
+    assert_eq!(texel.map(f32::to_bits), [0x8000_FFFF, 0x0000_4000, 0xFFFF_BFFF, 0x0042_0000]);
 }
 
 #[test]
