@@ -442,7 +442,7 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                     set_weight(region_weight(r));
 #endif
 #ifdef COMPANION
-                    set_companion(r, ray.origin, ray.dir, step);
+                    set_companion(r, ray.origin, ray.dir);
 #endif
 #ifdef INSETS
                     set_insets(ids[s], r.lut_offset, ray.origin, ray.dir);

@@ -130,17 +130,27 @@ fn dvr_classified(r: Region, q: vec3<f32>, sample: Classified, ratio: f32, ray: 
     let v = sample.v;
     let rgba = sample.rgba;
     let a = rgba.a * sample.weight;
-    var other = vec4(0.0);
+    // The companion's opacity o (0 without one, or outside it).
+    var o = 0.0;
 #ifdef COMPANION
     if companion.on && t >= companion.t_enter && t <= companion.t_leave {
-        other = vec4(sample.other.rgb, sample.other.a * (1.0 - sample.weight));
+        o = sample.other.a * (1.0 - sample.weight);
     }
 #endif
-    if a <= 0.0 && other.a <= 0.0 {
+    if a <= 0.0 && o <= 0.0 {
         return acc;
     }
+    // Both looks take one opacity correction, of their joint opacity 1 − (1 − a)(1 − o)
+    // (a step's transparency ((1 − a)(1 − o))^ratio is the reference's, compositing a
+    // then o at one ratio: render::pack::companions), shared in proportion to a and
+    // (1 − a)·o: the reference's shares where either is 0 and at ratio 1, within a
+    // level elsewhere (on llvmpipe the companion's own correction, a pow, cost 7 % of
+    // the frame). Without a companion, alpha is a corrected.
+    let joint = 1.0 - (1.0 - a) * (1.0 - o);
+    let corrected = correct_opacity(joint, ratio);
     // (Where a ≤ 0 this is 0, and composites nothing.)
-    var alpha = correct_opacity(a, ratio);
+    var alpha = corrected * select(1.0, a / joint, o > 0.0);
+    let other_alpha = corrected - alpha;
     var c = rgba.rgb;
     let labels = (r.flags & REGION_LABELS) != 0u;
     var needs_gradient = false;
@@ -184,17 +194,17 @@ fn dvr_classified(r: Region, q: vec3<f32>, sample: Classified, ratio: f32, ray: 
         }
 #endif
     }
-    var out = composite(acc, c, alpha);
 #ifdef COMPANION
-    if other.a > 0.0 {
-        var oc = other.rgb;
-        if shading {
-            oc = shade_with(oc, terms);
-        }
-        out = composite(out, oc, correct_opacity(other.a, companion.ratio));
+    var oc = sample.other.rgb;
+    if shading {
+        oc = shade_with(oc, terms);
     }
+    // (The host's share as its mode left it, then the companion's.)
+    let w = 1.0 - acc.a;
+    return acc + vec4((c * alpha + oc * other_alpha) * w, (alpha + other_alpha) * w);
+#else
+    return composite(acc, c, alpha);
 #endif
-    return out;
 }
 
 // The iso-surface between two samples, refined by bisection (reference: trace::refine).

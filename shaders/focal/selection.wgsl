@@ -12,7 +12,7 @@
 #import focal::types::{Region, REGION_SELECTION, REGION_KEEP_UNSELECTED, REGION_COMPANION}
 #import focal::bindings::{regions, occupancy}
 #import focal::sampling::trilinear_box
-#import focal::regions::{world_step, region_interval}
+#import focal::regions::region_interval
 
 const KEEP_NONE: u32 = 0u;
 const KEEP_SELECTED: u32 = 1u;
@@ -67,8 +67,6 @@ struct Companion {
     // The pair table of both looks (render::pack::pair_table; the current region's
     // width and a·t + b).
     table: u32,
-    // Its opacity-correction ratio for the march step.
-    ratio: f32,
     // The ray's interval inside it: outside, the region adds nothing. (naga_oil
     // refuses module field names that end in digits.)
     t_enter: f32,
@@ -78,9 +76,8 @@ struct Companion {
 
 var<private> companion: Companion;
 
-// The companion of region r on a ray from origin along dir marched at step (none when r
-// has none).
-fn set_companion(r: Region, origin: vec3<f32>, dir: vec3<f32>, step: f32) {
+// The companion of region r on a ray from origin along dir (none when r has none).
+fn set_companion(r: Region, origin: vec3<f32>, dir: vec3<f32>) {
     companion.on = (r.flags & REGION_COMPANION) != 0u;
     if companion.on {
         let c = regions[r.objects.z];
@@ -88,7 +85,6 @@ fn set_companion(r: Region, origin: vec3<f32>, dir: vec3<f32>, step: f32) {
         companion.t_enter = max(iv.x, 0.0);
         companion.t_leave = iv.y;
         companion.table = r.objects.y;
-        companion.ratio = c.native_step / (world_step(c, dir) * c.reference_length) * step;
     }
 }
 

@@ -157,9 +157,11 @@ pub fn constant_bricks(bricks: &crate::volume::BrickGrid, full: u16) -> Vec<u32>
 /// meets `b` (its samples would come between them; one that only touches it can take
 /// a sample on their common face without `b`), neither has holes or objects, `b` is
 /// plain DVR shaded as `a` is (it shares `a`'s gradient and Blinn-Phong terms) and
-/// steps no finer than `a` (the ray's step is the finest of the regions it crosses, and
-/// `b` no longer counts), and both tables map a sample alike, with channels in 0…1 (one
-/// [`pair_table`] holds both looks; tables of one volume map alike). Per region: the one drawn in its samples.
+/// steps as `a` does (the ray's step is the finest of the regions it crosses, and `b`
+/// no longer counts; one opacity correction serves both looks: `samples.wgsl`
+/// dvr_classified), and both tables map a sample alike, with channels in 0…1 (one
+/// [`pair_table`] holds both looks; tables of one volume map alike). Per region: the
+/// one drawn in its samples.
 pub fn companions(prepared: &[PreparedRegion], carried: bool) -> Vec<Option<usize>> {
     use crate::region::{Keep, vertices};
     let n = prepared.len();
@@ -206,7 +208,7 @@ pub fn companions(prepared: &[PreparedRegion], carried: bool) -> Vec<Option<usiz
                 && inside(pa)
                 && shaded_alike(pa)
                 && tables_alike(pa)
-                && pb.native_step >= pa.native_step
+                && pb.native_step == pa.native_step
         });
         let Some(a) = host else { continue };
         if (0..n).all(|c| c == a || c == b || !meet(&[pb.region, prepared[c].region])) {

@@ -342,6 +342,10 @@ fn a_selection_on_its_datas_grid_rides_in_the_second_channel() {
     let mut finer = scene_with(&on_grid, &on_grid);
     finer.appearances[1].step = 0.25;
     assert_eq!(pack(&finer, 2048).unwrap().features & (features::COMPANION | features::DVR_PAIRS), features::DVR_PAIRS);
+    // And a coarser one: one opacity correction serves both looks only at one step.
+    let mut coarser = scene_with(&on_grid, &on_grid);
+    coarser.appearances[1].step = 2.0;
+    assert_eq!(pack(&coarser, 2048).unwrap().features & (features::COMPANION | features::DVR_PAIRS), features::DVR_PAIRS);
     // So is a look that modulates by the gradient.
     let mut modulated = scene_with(&on_grid, &on_grid);
     modulated.appearances[1].mode = Mode::GradientDvr;
