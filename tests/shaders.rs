@@ -171,6 +171,18 @@ fn the_feature_lens_compute_shader_composes_and_validates() {
     compose_and_validate("shaders/feature.wgsl", HashMap::new());
 }
 
+/// The sizes the shaders take as constants are the renderer's.
+#[test]
+fn shader_constants_match_the_renderer() {
+    let types = read("shaders/focal/types.wgsl");
+    let constant = |name: &str| {
+        let line = types.lines().find(|l| l.starts_with(&format!("const {name}: u32 = "))).unwrap_or_else(|| panic!("no {name}"));
+        line.trim_start_matches(&format!("const {name}: u32 = ")).trim_end_matches("u;").parse::<u32>().unwrap()
+    };
+    assert_eq!(constant("LUT_ATLAS_WIDTH"), focal::render::pack::LUT_ATLAS_WIDTH);
+    assert_eq!(constant("MAX_INSETS") as usize, focal::render::gpu_types::MAX_INSETS);
+}
+
 #[test]
 fn def_names_match_the_renderer() {
     let names: Vec<&str> = focal::render::gpu_types::features::NAMES.iter().map(|(_, n)| *n).collect();

@@ -24,7 +24,7 @@ fn is_projection(mode: u32) -> bool {
 fn shaded(r: Region, c: vec3<f32>, q: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
 #ifdef HAS_SHADING
     if (r.flags & REGION_SHADING) != 0u {
-        let g = (r.normal_matrix * vec4(index_gradient(r, q, scene.lut_atlas_width), 0.0)).xyz;
+        let g = (r.normal_matrix * vec4(index_gradient(r, q), 0.0)).xyz;
         return shade(c, g, dir, settings.light, r.shading, true);
     }
 #endif
@@ -89,7 +89,7 @@ fn dvr_classify_at(r: Region, q: vec3<f32>, located: bool, lut: u32) -> Classifi
 #endif
 #ifdef HAS_LABELS
     if (r.flags & REGION_LABELS) != 0u {
-        rgba = classify_label(r, nearest_code(r, q), scene.lut_atlas_width);
+        rgba = classify_label(r, nearest_code(r, q));
     } else {
         v = value_at(r, q, vd, located);
         rgba = classify_at(r, lut, v, &other);
@@ -109,11 +109,11 @@ fn dvr_classify_at(r: Region, q: vec3<f32>, located: bool, lut: u32) -> Classifi
 // `other`) the companion's, both from their pair table (companion.table).
 fn classify_at(r: Region, lut: u32, v: f32, other: ptr<function, vec4<f32>>) -> vec4<f32> {
 #ifdef COMPANION
-    let looks = filtered_looks(select(lut, companion.table, companion.on), r.lut_width, r.lut_a, r.lut_b, v, scene.lut_atlas_width, companion.on);
+    let looks = filtered_looks(select(lut, companion.table, companion.on), r.lut_width, r.lut_a, r.lut_b, v, companion.on);
     *other = looks.second;
     return looks.first;
 #else
-    return filtered(r, lut, v, scene.lut_atlas_width);
+    return filtered(r, lut, v);
 #endif
 }
 
@@ -166,7 +166,7 @@ fn dvr_classified(r: Region, q: vec3<f32>, sample: Classified, ratio: f32, ray: 
     needs_gradient = needs_gradient || (r.flags & REGION_SHADING) != 0u;
 #endif
     if needs_gradient {
-        let gi = index_gradient_at(r, q, scene.lut_atlas_width, located);
+        let gi = index_gradient_at(r, q, located);
         let g = (r.normal_matrix * vec4(gi, 0.0)).xyz;
         let magnitude = min(length(gi) / gradient_norm(r), 1.0);
 #ifdef HAS_GRADIENT_MODULATION
@@ -182,7 +182,7 @@ fn dvr_classified(r: Region, q: vec3<f32>, sample: Classified, ratio: f32, ray: 
         if r.mode == MODE_CONTEXT && !labels {
             var lambda = vec2(1.0);
             if (r.flags & REGION_LAMBDA) != 0u {
-                lambda = classify_lambda(r, v, scene.lut_atlas_width);
+                lambda = classify_lambda(r, v);
             }
             let eye = eye_distance(r, ray.origin, ray.dir, t);
             alpha = context_opacity(r, alpha, magnitude, clamp(terms.x + terms.y, 0.0, 1.0), eye, acc.a, lambda);
@@ -226,7 +226,7 @@ fn refine_iso(r: Region, ray: Ray, ta_in: f32, va: f32, tb_in: f32) -> f32 {
 
 // The iso-surface at voxel position q, shaded and opaque (reference: trace::iso_surface).
 fn iso_surface(r: Region, q: vec3<f32>, dir: vec3<f32>, acc: vec4<f32>) -> vec4<f32> {
-    let rgba = classify(r, r.iso, scene.lut_atlas_width);
+    let rgba = classify(r, r.iso);
     return composite(acc, shaded(r, rgba.rgb, q, dir), 1.0);
 }
 
@@ -265,6 +265,6 @@ fn emit_projection(r: Region, vmax: f32, vmin: f32, vsum: f32, count: u32, acc: 
     if !is_projection(r.mode) || count == 0u {
         return acc;
     }
-    let rgba = classify(r, projected(r.mode, vmax, vmin, vsum, count), scene.lut_atlas_width);
+    let rgba = classify(r, projected(r.mode, vmax, vmin, vsum, count));
     return composite(acc, rgba.rgb, rgba.a);
 }

@@ -5,7 +5,7 @@
 // box of the atlas), central-difference gradients, nearest label codes, brick occupancy
 // and min-max (reference: volume::sample, volume::bricks).
 
-#import focal::types::{Region, REGION_LABELS}
+#import focal::types::{Region, REGION_LABELS, LUT_ATLAS_WIDTH}
 #import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy, lut_atlas, brick_cache}
 #import focal::bricked::{is_bricked, level_zero, bricked_locate, bricked_texel, bricked_uvw, bricked_box_exit, box_exit, bricked_step_factor, sub_block_visible, sub_block_exit, bricked_gradient, bricked_gradient_max, bc_kind, bc_code, BRICKED_TEXEL, BRICKED_EMPTY}
 
@@ -179,42 +179,44 @@ fn nearest_code(r: Region, q: vec3<f32>) -> u32 {
 #endif
 }
 
-// Texel `index` of the lookup-table atlas, rows of atlas_width: its bits, and the f32
+// Texel `index` of the lookup-table atlas, rows of LUT_ATLAS_WIDTH: its bits, and the f32
 // colour they hold in every table but a pair table.
-fn lut_bits(index: u32, atlas_width: u32) -> vec4<u32> {
-    return textureLoad(lut_atlas, vec2<i32>(i32(index % atlas_width), i32(index / atlas_width)), 0);
+fn lut_bits(index: u32) -> vec4<u32> {
+    // (A constant width, a power of two: a mask and a shift. A uniform one made llvmpipe
+// divide lane by lane, twice a texel.)
+    return textureLoad(lut_atlas, vec2<i32>(i32(index % LUT_ATLAS_WIDTH), i32(index / LUT_ATLAS_WIDTH)), 0);
 }
 
-fn lut_texel(index: u32, atlas_width: u32) -> vec4<f32> {
-    return bitcast<vec4<f32>>(lut_bits(index, atlas_width));
+fn lut_texel(index: u32) -> vec4<f32> {
+    return bitcast<vec4<f32>>(lut_bits(index));
 }
 
-fn label_alpha(r: Region, q: vec3<f32>, atlas_width: u32) -> f32 {
+fn label_alpha(r: Region, q: vec3<f32>) -> f32 {
     let code = nearest_code(r, q);
     if code >= r.lut_width {
         return 0.0;
     }
-    return lut_texel(r.lut_offset + code, atlas_width).a;
+    return lut_texel(r.lut_offset + code).a;
 }
 
 // Central-difference gradient in normalised units per voxel (index axes). Label
 // volumes use the gradient of the label opacity field.
-fn index_gradient(r: Region, q: vec3<f32>, atlas_width: u32) -> vec3<f32> {
-    return index_gradient_at(r, q, atlas_width, false);
+fn index_gradient(r: Region, q: vec3<f32>) -> vec3<f32> {
+    return index_gradient_at(r, q, false);
 }
 
 // index_gradient where `located` (a literal at each call site) says the last page
 // look-up was of q itself (the sample's own value was just fetched): a bricked region
 // then takes its answer as it stands. (On llvmpipe a look-up is a dozen loads and a
 // page walk, and a shaded DVR sample of a bricked volume made four at the same place.)
-fn index_gradient_at(r: Region, q: vec3<f32>, atlas_width: u32, located: bool) -> vec3<f32> {
+fn index_gradient_at(r: Region, q: vec3<f32>, located: bool) -> vec3<f32> {
     var g = vec3(0.0);
 #ifdef HAS_LABELS
     if (r.flags & REGION_LABELS) != 0u {
         for (var a = 0; a < 3; a++) {
             var e = vec3(0.0);
             e[a] = 1.0;
-            g[a] = label_alpha(r, q + e, atlas_width) - label_alpha(r, q - e, atlas_width);
+            g[a] = label_alpha(r, q + e) - label_alpha(r, q - e);
         }
         return 0.5 * g;
     }

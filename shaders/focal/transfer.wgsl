@@ -9,10 +9,10 @@
 
 // The table of `width` texels at `base`, linearly filtered at the sample t, which
 // a·t + b maps onto it.
-fn filtered_table(base: u32, width: u32, a: f32, b: f32, t: f32, atlas_width: u32) -> vec4<f32> {
+fn filtered_table(base: u32, width: u32, a: f32, b: f32, t: f32) -> vec4<f32> {
     let x = table_position(width, a, b, t);
     let i = u32(x.x);
-    return mix(lut_texel(base + i, atlas_width), lut_texel(base + i + 1u, atlas_width), x.y);
+    return mix(lut_texel(base + i), lut_texel(base + i + 1u), x.y);
 }
 
 // Where the sample t falls in a table of `width` texels that a·t + b maps onto: the
@@ -43,11 +43,11 @@ fn pair_look(bits: vec2<u32>) -> vec4<f32> {
 // table, each texel the first look's colour (xy) and the second's (zw) as 16-bit
 // normalised numbers; otherwise its f32 colour is the first look and the second is
 // transparent.
-fn filtered_looks(base: u32, width: u32, a: f32, b: f32, t: f32, atlas_width: u32, paired: bool) -> Looks {
+fn filtered_looks(base: u32, width: u32, a: f32, b: f32, t: f32, paired: bool) -> Looks {
     let x = table_position(width, a, b, t);
     let i = u32(x.x);
-    let lo = lut_bits(base + i, atlas_width);
-    let hi = lut_bits(base + i + 1u, atlas_width);
+    let lo = lut_bits(base + i);
+    let hi = lut_bits(base + i + 1u);
     var looks = Looks(mix(bitcast<vec4<f32>>(lo), bitcast<vec4<f32>>(hi), x.y), vec4(0.0));
     if paired {
         looks.first = mix(pair_look(lo.xy), pair_look(hi.xy), x.y);
@@ -57,25 +57,25 @@ fn filtered_looks(base: u32, width: u32, a: f32, b: f32, t: f32, atlas_width: u3
 }
 
 // Region r's table of lut_width texels at `base`, filtered at t.
-fn filtered(r: Region, base: u32, t: f32, atlas_width: u32) -> vec4<f32> {
-    return filtered_table(base, r.lut_width, r.lut_a, r.lut_b, t, atlas_width);
+fn filtered(r: Region, base: u32, t: f32) -> vec4<f32> {
+    return filtered_table(base, r.lut_width, r.lut_a, r.lut_b, t);
 }
 
-fn classify(r: Region, t: f32, atlas_width: u32) -> vec4<f32> {
-    return filtered(r, r.lut_offset, t, atlas_width);
+fn classify(r: Region, t: f32) -> vec4<f32> {
+    return filtered(r, r.lut_offset, t);
 }
 
 // (λt, λs) of context-preserving regions: the lut_width texels after the colours
 // (reference: Lut::sample_lambda).
-fn classify_lambda(r: Region, t: f32, atlas_width: u32) -> vec2<f32> {
-    return filtered(r, r.lut_offset + r.lut_width, t, atlas_width).xy;
+fn classify_lambda(r: Region, t: f32) -> vec2<f32> {
+    return filtered(r, r.lut_offset + r.lut_width, t).xy;
 }
 
-fn classify_label(r: Region, code: u32, atlas_width: u32) -> vec4<f32> {
+fn classify_label(r: Region, code: u32) -> vec4<f32> {
     if code >= r.lut_width {
         return vec4(0.0);
     }
-    return lut_texel(r.lut_offset + code, atlas_width);
+    return lut_texel(r.lut_offset + code);
 }
 
 fn correct_opacity(alpha: f32, ratio: f32) -> f32 {

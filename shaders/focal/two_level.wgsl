@@ -48,7 +48,7 @@ fn part_of(r: Region, labels: Region, p: vec3<f32>, v: f32) -> u32 {
     if code >= labels.lut_width {
         return rest;
     }
-    let candidates = lut_texel(labels.lut_offset + code, scene.lut_atlas_width);
+    let candidates = lut_texel(labels.lut_offset + code);
     for (var i = 0; i < 4; i++) {
         let k = u32(candidates[i] + 0.5);
         if k == 0u {
@@ -68,7 +68,7 @@ fn code_class(labels: Region, code: u32) -> u32 {
     if code >= labels.lut_width {
         return 0xffffu;
     }
-    return u32(lut_texel(labels.lut_offset + labels.lut_width + code, scene.lut_atlas_width).x + 0.5);
+    return u32(lut_texel(labels.lut_offset + labels.lut_width + code).x + 0.5);
 }
 
 // Whether the cell of label voxel q may hold more than one label: its brick's bit in
@@ -157,7 +157,7 @@ fn close_segment(r: Region, part: Region, open: ptr<function, Open>, acc: vec4<f
     var out = acc;
     let o = *open;
     if o.part < r.objects.y && o.count > 0u && is_projection(part.mode) {
-        let rgba = classify(part, projected(part.mode, o.max, o.min, o.sum, o.count), scene.lut_atlas_width);
+        let rgba = classify(part, projected(part.mode, o.max, o.min, o.sum, o.count));
         out = composite(acc, rgba.rgb, rgba.a);
     }
     *open = fresh(o.part);
@@ -221,7 +221,7 @@ fn two_level_sample(r: Region, labels: Region, part: ptr<function, Region>, open
 #endif
 #ifdef HAS_DVR
     let own = own_value(r, labels, q, v);
-    out = dvr_classified(*part, q, classified(own, classify(*part, own, scene.lut_atlas_width)), ratio, ray, t, out, false);
+    out = dvr_classified(*part, q, classified(own, classify(*part, own)), ratio, ray, t, out, false);
 #endif
     return out;
 }

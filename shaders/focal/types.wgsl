@@ -81,7 +81,7 @@ struct Settings {
 struct SceneInfo {
     inv_atlas_size: vec4<f32>,
     region_count: u32,
-    lut_atlas_width: u32,
+    pad_a: u32,
     // Bound on the iterations of every loop along a ray (render::pack::march_bound).
     max_steps: u32,
     // The clip windows drawn in their datasets' samples, insets[0 … inset_count)
@@ -92,6 +92,9 @@ struct SceneInfo {
 
 // (render::gpu_types::MAX_INSETS)
 const MAX_INSETS: u32 = 4u;
+
+// Texels per row of the lookup-table atlas (render::pack::LUT_ATLAS_WIDTH).
+const LUT_ATLAS_WIDTH: u32 = 4096u;
 
 // A clip window drawn in place: its box's planes (n·x − d, negative inside), the
 // record of the region it is drawn in, its table's offset in the lookup atlas.

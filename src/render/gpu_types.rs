@@ -305,8 +305,8 @@ pub struct GpuSceneInfo {
     /// 1 / size of the volume atlas in texels (xyz).
     pub inv_atlas_size: Vec4,
     pub region_count: u32,
-    /// Width of the LUT atlas in texels.
-    pub lut_atlas_width: u32,
+    /// (The LUT atlas's width is a shader constant, `LUT_ATLAS_WIDTH`.)
+    pub pad_a: u32,
     /// Bound on the iterations of every loop along a ray ([`super::pack::march_bound`]).
     pub max_steps: u32,
     /// How many of `insets` are in use.

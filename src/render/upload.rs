@@ -329,10 +329,10 @@ fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScen
     let info = GpuSceneInfo {
         inv_atlas_size: inv.extend(0.0),
         region_count: packed.region_count,
-        lut_atlas_width: LUT_ATLAS_WIDTH,
         max_steps: packed.max_steps,
         inset_count: packed.insets.len().min(MAX_INSETS) as u32,
         insets: std::array::from_fn(|i| packed.insets.get(i).copied().unwrap_or_default()),
+        ..Default::default()
     };
     let mut ub = UniformBuffer::new(Vec::new());
     let _ = ub.write(&info);
