@@ -65,7 +65,11 @@ fn classified(v: f32, rgba: vec4<f32>) -> Classified {
 // Whether a classified sample can add anything to the ray (the companion's look left
 // out of account where the ray is outside it: a sample too many is only classified).
 fn adds_something(c: Classified) -> bool {
+#ifdef COMPANION
     return c.rgba.a * c.weight > 0.0 || c.other.a * (1.0 - c.weight) > 0.0;
+#else
+    return c.rgba.a * c.weight > 0.0;
+#endif
 }
 
 // The first half of dvr_sample: the sample at q classified.
@@ -146,7 +150,10 @@ fn dvr_classified(r: Region, q: vec3<f32>, sample: Classified, ratio: f32, ray: 
     // (1 − a)·o: the reference's shares where either is 0 and at ratio 1, within a
     // level elsewhere (on llvmpipe the companion's own correction, a pow, cost 7 % of
     // the frame). Without a companion, alpha is a corrected.
-    let joint = 1.0 - (1.0 - a) * (1.0 - o);
+    var joint = a;
+#ifdef COMPANION
+    joint = 1.0 - (1.0 - a) * (1.0 - o);
+#endif
     let corrected = correct_opacity(joint, ratio);
     // (Where a ≤ 0 this is 0, and composites nothing.)
     var alpha = corrected * select(1.0, a / joint, o > 0.0);

@@ -11,17 +11,21 @@
 // a·t + b maps onto it.
 fn filtered_table(base: u32, width: u32, a: f32, b: f32, t: f32) -> vec4<f32> {
     let x = table_position(width, a, b, t);
-    let i = u32(x.x);
-    return mix(lut_texel(base + i), lut_texel(base + i + 1u), x.y);
+    return mix(lut_texel(base + x.i), lut_texel(base + x.i + 1u), x.f);
 }
 
-// Where the sample t falls in a table of `width` texels that a·t + b maps onto: the
-// first of the two texels it lies between (x) and the weight of the second (y).
-fn table_position(width: u32, a: f32, b: f32, t: f32) -> vec2<f32> {
+// Where a sample falls in a table: between texels i and i + 1, at weight f of the second.
+struct TablePosition {
+    i: u32,
+    f: f32,
+}
+
+// Where the sample t falls in a table of `width` texels that a·t + b maps onto.
+fn table_position(width: u32, a: f32, b: f32, t: f32) -> TablePosition {
     let n = f32(width);
     let x = clamp((a * t + b) * n - 0.5, 0.0, n - 1.0);
     let i = min(u32(x), width - 2u);
-    return vec2(f32(i), x - f32(i));
+    return TablePosition(i, x - f32(i));
 }
 
 // Two looks of one volume classified by one lookup (render::pack::pair_table: an
@@ -45,13 +49,12 @@ fn pair_look(bits: vec2<u32>) -> vec4<f32> {
 // transparent.
 fn filtered_looks(base: u32, width: u32, a: f32, b: f32, t: f32, paired: bool) -> Looks {
     let x = table_position(width, a, b, t);
-    let i = u32(x.x);
-    let lo = lut_bits(base + i);
-    let hi = lut_bits(base + i + 1u);
-    var looks = Looks(mix(bitcast<vec4<f32>>(lo), bitcast<vec4<f32>>(hi), x.y), vec4(0.0));
+    let lo = lut_bits(base + x.i);
+    let hi = lut_bits(base + x.i + 1u);
+    var looks = Looks(mix(bitcast<vec4<f32>>(lo), bitcast<vec4<f32>>(hi), x.f), vec4(0.0));
     if paired {
-        looks.first = mix(pair_look(lo.xy), pair_look(hi.xy), x.y);
-        looks.second = mix(pair_look(lo.zw), pair_look(hi.zw), x.y);
+        looks.first = mix(pair_look(lo.xy), pair_look(hi.xy), x.f);
+        looks.second = mix(pair_look(lo.zw), pair_look(hi.zw), x.f);
     }
     return looks;
 }
