@@ -10,7 +10,7 @@
 @group(0) @binding(4) var<storage, read> planes: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> occupancy: array<u32>;
 // The lookup tables' texels as bits: f32 colours (sampling::lut_texel), or two looks'
-// colours as half floats in a pair table (transfer::filtered_looks).
+// colours as 16-bit normalised pairs in a pair table (transfer::filtered_looks).
 @group(0) @binding(6) var lut_atlas: texture_2d<u32>;
 @group(0) @binding(7) var volume_atlas: texture_3d<f32>;
 @group(0) @binding(8) var brick_atlas: texture_3d<u32>;

@@ -121,6 +121,14 @@ fn classify_at(r: Region, lut: u32, v: f32, other: ptr<function, vec4<f32>>) -> 
 #endif
 }
 
+// The companion's share other_alpha, which lay behind the host's opacity `before`, behind
+// the host's opacity `after` that its mode (gradient modulation, equation 5 of
+// context-preserving DVR) made of it: the reference composites the companion under the
+// host's final opacity (exact at ratio 1).
+fn behind(other_alpha: f32, before: f32, after: f32) -> f32 {
+    return select(other_alpha, other_alpha * (1.0 - after) / (1.0 - before), before < 1.0);
+}
+
 // dvr_sample after classification: the sample's value (0 for labels) gave its colour,
 // whose opacity takes its weight (1 for segmented regions' parts). With COMPANION the
 // current companion region's look (classified with it) follows at the same voxel,
@@ -150,14 +158,15 @@ fn dvr_classified(r: Region, q: vec3<f32>, sample: Classified, ratio: f32, ray: 
     // (1 − a)·o: the reference's shares where either is 0 and at ratio 1, within a
     // level elsewhere (on llvmpipe the companion's own correction, a pow, cost 7 % of
     // the frame). Without a companion, alpha is a corrected.
+    // (Written a + o·(1 − a): positive where either is, and exactly a where o is 0.)
     var joint = a;
 #ifdef COMPANION
-    joint = 1.0 - (1.0 - a) * (1.0 - o);
+    joint = a + o * (1.0 - a);
 #endif
     let corrected = correct_opacity(joint, ratio);
     // (Where a ≤ 0 this is 0, and composites nothing.)
-    var alpha = corrected * select(1.0, a / joint, o > 0.0);
-    let other_alpha = corrected - alpha;
+    var alpha = corrected * select(1.0, a / joint, o > 0.0 && joint > 0.0);
+    var other_alpha = corrected - alpha;
     var c = rgba.rgb;
     let labels = (r.flags & REGION_LABELS) != 0u;
     var needs_gradient = false;
@@ -178,7 +187,11 @@ fn dvr_classified(r: Region, q: vec3<f32>, sample: Classified, ratio: f32, ray: 
         let magnitude = min(length(gi) / gradient_norm(r), 1.0);
 #ifdef HAS_GRADIENT_MODULATION
         if r.mode == MODE_GRADIENT_DVR && !labels {
+            let before = alpha;
             alpha *= magnitude;
+#ifdef COMPANION
+            other_alpha = behind(other_alpha, before, alpha);
+#endif
         }
 #endif
         // The Blinn-Phong terms serve both the shading and s(P) of equation 5.
@@ -192,7 +205,11 @@ fn dvr_classified(r: Region, q: vec3<f32>, sample: Classified, ratio: f32, ray: 
                 lambda = classify_lambda(r, v);
             }
             let eye = eye_distance(r, ray.origin, ray.dir, t);
+            let before = alpha;
             alpha = context_opacity(r, alpha, magnitude, clamp(terms.x + terms.y, 0.0, 1.0), eye, acc.a, lambda);
+#ifdef COMPANION
+            other_alpha = behind(other_alpha, before, alpha);
+#endif
         }
 #endif
 #ifdef HAS_SHADING

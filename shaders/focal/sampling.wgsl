@@ -182,8 +182,8 @@ fn nearest_code(r: Region, q: vec3<f32>) -> u32 {
 // Texel `index` of the lookup-table atlas, rows of LUT_ATLAS_WIDTH: its bits, and the f32
 // colour they hold in every table but a pair table.
 fn lut_bits(index: u32) -> vec4<u32> {
-    // (A constant width, a power of two: a mask and a shift. A uniform one made llvmpipe
-// divide lane by lane, twice a texel.)
+    // (A constant width, a power of two: a mask and a shift. A uniform one made
+    // llvmpipe divide lane by lane, twice a texel.)
     return textureLoad(lut_atlas, vec2<i32>(i32(index % LUT_ATLAS_WIDTH), i32(index / LUT_ATLAS_WIDTH)), 0);
 }
 

@@ -190,10 +190,10 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
     out.atlas.size = out.atlas.size.max(UVec3::ONE);
     out.brick_atlas.size = out.brick_atlas.size.max(UVec3::ONE);
     if out.lut.is_empty() {
-        out.lut.push([0.0; 4]);
+        out.lut.push([0; 4]);
     }
     let rows = out.lut_rows() as usize;
-    out.lut.resize(rows * LUT_ATLAS_WIDTH as usize, [0.0; 4]);
+    out.lut.resize(rows * LUT_ATLAS_WIDTH as usize, [0; 4]);
     if out.occupancy.is_empty() {
         out.occupancy.push(0);
     }
@@ -224,7 +224,7 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
     let label_slot = slots.get(1).copied().unwrap_or(slots[0]);
     let labels = objects.label_volume;
     let lut_offset = out.lut.len() as u32;
-    out.lut.extend(objects.table.candidates.iter().map(|c| c.map(|k| k as f32)));
+    out.lut.extend(objects.table.candidates.iter().map(|c| texel(c.map(|k| k as f32))));
     let world_to_labels = objects.data_to_label * p.region.world_to_voxel;
     // Each code's class after its candidates (`twolevel::code_classes`), and where a
     // cell may straddle labels (`twolevel::boundary_bricks`) as the occupancy bits
@@ -232,7 +232,7 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
     // (With own values only: the shader reads neither otherwise.)
     let (mut flags, mut bricks, occupancy_offset) = (0, UVec4::ZERO, out.occupancy.len() as u32);
     if objects.own_values {
-        out.lut.extend(objects.classes.iter().map(|&c| [c as f32, 0.0, 0.0, 0.0]));
+        out.lut.extend(objects.classes.iter().map(|&c| texel([c as f32, 0.0, 0.0, 0.0])));
         let grid = labels.bricks();
         let boundary = crate::twolevel::boundary_bricks(grid);
         bricks = grid.dims.extend(grid.size);
@@ -422,17 +422,17 @@ fn pack_region(p: &PreparedRegion, holes: &[[Plane; 6]], levels: &[UVec3], brick
     let mut flags = 0;
     let (lut_a, lut_b, lut_width, labels) = match &p.lookup {
         PreparedLookup::Transfer { lut, a, b } => {
-            out.lut.extend_from_slice(&lut.rgba);
+            out.lut.extend(lut.rgba.iter().map(|&c| texel(c)));
             // Context-preserving regions with λ channels read (λt, λs) from the next
             // `lut_width` texels (without, both are 1 and nothing is read).
             if p.mode == Mode::Context && lut.lambda.iter().any(|l| *l != [1.0, 1.0]) {
-                out.lut.extend(lut.lambda.iter().map(|l| [l[0], l[1], 0.0, 0.0]));
+                out.lut.extend(lut.lambda.iter().map(|l| texel([l[0], l[1], 0.0, 0.0])));
                 flags |= region_flags::LAMBDA;
             }
             (*a, *b, lut.rgba.len() as u32, false)
         }
         PreparedLookup::Labels(table) => {
-            out.lut.extend_from_slice(table);
+            out.lut.extend(table.iter().map(|&c| texel(c)));
             (0.0, 0.0, table.len() as u32, true)
         }
     };
@@ -549,7 +549,7 @@ mod packed;
 mod selection;
 pub use insets::{Inset, MAX_INSETS, inset_features, insets};
 use insets::{draw_in_place, kept_holes};
-pub use packed::{Atlas, LUT_ATLAS_WIDTH, PackedScene, atlas_layout, gpu_plane};
+pub use packed::{Atlas, LUT_ATLAS_WIDTH, PackedScene, atlas_layout, gpu_plane, texel, texel_colour};
 pub use selection::{companions, constant_bricks, doi_channels, pair_table, unorm_pair};
 use selection::{draw_in, pack_selection};
 

@@ -34,8 +34,8 @@ pub fn init_pipeline(mut commands: Commands, device: Res<RenderDevice>, fullscre
                 storage_buffer_read_only_sized(false, None),
                 storage_buffer_read_only_sized(false, None),
                 storage_buffer_read_only_sized(false, None),
-                // (The lookup tables' bits: f32 colours, or half-float pairs of two
-                // looks; render::pack::pair_table.)
+                // (The lookup tables' bits: f32 colours, or 16-bit normalised pairs
+                // of two looks; render::pack::pair_table.)
                 texture_2d(TextureSampleType::Uint),
                 texture_3d(float(true)),
                 texture_3d(TextureSampleType::Uint),

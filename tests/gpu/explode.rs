@@ -66,6 +66,16 @@ fn exploded_halves(gpu: &mut Gpu, carried: bool) {
     // At rest the selection is drawn in the parts' samples (render::pack::companions).
     assert_eq!(features & COMPANION != 0, carried);
     assert_matches(&format!("exploded_at_rest_{carried}"), &at_rest, &cpu(gpu));
+    // The head's look modulated by the gradient (its opacity lowered where the data is
+    // flat): the selection's look in its samples lies behind the head's opacity as
+    // modulated, as the reference composites it.
+    let look = gpu.off.world_mut().get::<Dataset>(data).unwrap().appearance.clone();
+    gpu.off.world_mut().get_mut::<Dataset>(data).unwrap().appearance = Appearance { mode: Mode::GradientDvr, ..look.clone() };
+    let modulated = gpu.off.capture().unwrap();
+    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
+    assert_eq!(focal::render::pack::pack(&scene, 2048).unwrap().features & COMPANION != 0, carried);
+    assert_matches(&format!("exploded_at_rest_modulated_{carried}"), &modulated, &cpu(gpu));
+    gpu.off.world_mut().get_mut::<Dataset>(data).unwrap().appearance = look;
     // At rest with the head nearly transparent and the selection drawn by a grey ramp:
     // the selection, drawn in the parts' samples, shows through the head.
     let skin = gpu.off.world_mut().get::<Dataset>(data).unwrap().appearance.clone();

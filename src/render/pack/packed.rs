@@ -14,10 +14,10 @@ pub struct PackedScene {
     pub regions: Vec<GpuRegion>,
     /// Plane `(normal, offset)` per entry; regions index ranges of it.
     pub planes: Vec<Vec4>,
-    /// RGBA texels, `LUT_ATLAS_WIDTH` per row, rows stacked: `f32` colours, and the
-    /// pair tables' half floats carried as the bits of `f32`s
-    /// ([`crate::render::pack::pair_table`]); the GPU reads the bits.
-    pub lut: Vec<[f32; 4]>,
+    /// RGBA texels as bits, `LUT_ATLAS_WIDTH` per row, rows stacked: `f32` colours
+    /// ([`texel`]), and the pair tables' 16-bit normalised pairs
+    /// ([`crate::render::pack::pair_table`]).
+    pub lut: Vec<[u32; 4]>,
     /// Occupancy bits (bit `i % 32` of word `i / 32` is brick `i`).
     pub occupancy: Vec<u32>,
     /// Scene volume indices placed in the atlases, in atlas order.
@@ -88,6 +88,16 @@ impl PackedScene {
     pub fn lut_rows(&self) -> u32 {
         (self.lut.len() as u32).div_ceil(LUT_ATLAS_WIDTH).max(1)
     }
+}
+
+/// A lookup-atlas texel of an `f32` colour (its bits: the shader's `bitcast`).
+pub fn texel(c: [f32; 4]) -> [u32; 4] {
+    c.map(f32::to_bits)
+}
+
+/// The `f32` colour of a texel made by [`texel`].
+pub fn texel_colour(t: [u32; 4]) -> [f32; 4] {
+    t.map(f32::from_bits)
 }
 
 /// A plane as the shader reads it: `(n, d)`, `n·x − d` negative inside.

@@ -5,7 +5,7 @@
 
 use glam::Mat4;
 
-use super::packed::PackedScene;
+use super::packed::{PackedScene, texel_colour};
 use crate::reference::prepare::{PreparedLookup, PreparedRegion};
 use crate::region::Mode;
 use crate::region::meet;
@@ -58,7 +58,7 @@ pub fn pair_table(out: &mut PackedScene, a: usize, b: usize) -> u32 {
     let (ra, rb) = (out.regions[a], out.regions[b]);
     let offset = out.lut.len() as u32;
     for i in 0..ra.lut_width.min(rb.lut_width) {
-        let texel = unorm_pair(out.lut[(ra.lut_offset + i) as usize], out.lut[(rb.lut_offset + i) as usize]);
+        let texel = unorm_pair(texel_colour(out.lut[(ra.lut_offset + i) as usize]), texel_colour(out.lut[(rb.lut_offset + i) as usize]));
         out.lut.push(texel);
     }
     offset
@@ -66,11 +66,10 @@ pub fn pair_table(out: &mut PackedScene, a: usize, b: usize) -> u32 {
 
 /// A pair table's texel: `first`'s colour then `second`'s (channels in 0…1), two
 /// 16-bit normalised numbers to each 32 bits, the first in the lower half (WGSL's
-/// pack2x16unorm: ⌊0.5 + 65535·x⌋), carried as the bits of `f32`s (the atlas holds
-/// bits, [`crate::render::pack::PackedScene::lut`]; only arithmetic could change a NaN's).
-pub fn unorm_pair(first: [f32; 4], second: [f32; 4]) -> [f32; 4] {
+/// pack2x16unorm: ⌊0.5 + 65535·x⌋).
+pub fn unorm_pair(first: [f32; 4], second: [f32; 4]) -> [u32; 4] {
     let bits = |x: f32| (0.5 + 65535.0 * x.clamp(0.0, 1.0)).floor() as u32;
-    let two = |lo: f32, hi: f32| f32::from_bits(bits(lo) | bits(hi) << 16);
+    let two = |lo: f32, hi: f32| bits(lo) | bits(hi) << 16;
     [two(first[0], first[1]), two(first[2], first[3]), two(second[0], second[1]), two(second[2], second[3])]
 }
 
