@@ -10,8 +10,7 @@
 // The table of `width` texels at `base`, linearly filtered at the sample t, which
 // a·t + b maps onto it.
 fn filtered_table(base: u32, width: u32, a: f32, b: f32, t: f32) -> vec4<f32> {
-    let x = table_position(width, a, b, t);
-    return mix(lut_texel(base + x.i), lut_texel(base + x.i + 1u), x.f);
+    return filtered_looks(base, width, a, b, t, false).first;
 }
 
 // Where a sample falls in a table: between texels i and i + 1, at weight f of the second.
