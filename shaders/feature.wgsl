@@ -14,7 +14,7 @@
 
 #import focal::types::Region
 #import focal::bindings::regions
-#import focal::regions::{region_interval, in_hole, to_voxel}
+#import focal::regions::{region_interval, in_hole, to_voxel, cut_by_plane}
 #import focal::sampling::nearest_code
 #import focal::camera::camera_ray
 
@@ -35,9 +35,12 @@ struct FeatureParams {
     cell: vec2<f32>,
     // Marching step (world units).
     step: f32,
-    pad_a: f32,
+    // 1 where the volume holds the label: the world planes (n, d: n·x − d ≤ 0 inside)
+    // of a box outside which no sample meets it (lens::feature::FeatureJob::within).
+    present: u32,
     pad_b: f32,
     pad_c: f32,
+    within: array<vec4<f32>, 6>,
 }
 
 @group(1) @binding(0) var<uniform> job: FeatureParams;
@@ -54,17 +57,37 @@ fn in_grid(id: vec3<u32>) -> bool {
     return id.x < job.cols && id.y < job.rows;
 }
 
+// The march of the samples start + (k + ½)·step of the region's span that lie in the
+// label's box (reference: lens::feature::feature_mask, first_sample).
 fn marches_into_feature(uv: vec2<f32>) -> bool {
+    if job.present == 0u {
+        return false;
+    }
     let ray = camera_ray(uv);
+    var within = vec2(-3.4e38, 3.4e38);
+    for (var i = 0u; i < 6u; i++) {
+        within = cut_by_plane(within, job.within[i], ray.origin, ray.dir);
+    }
+    if within.x > within.y {
+        return false;
+    }
     let r = regions[job.region];
     let span = region_interval(r, ray.origin, ray.dir);
-    var t = max(span.x, 0.0) + 0.5 * job.step;
-    for (var k = 0u; k < MAX_MARCH && t < span.y; k++) {
+    let start = max(span.x, 0.0);
+    let end = min(span.y, within.y);
+    let first = floor((within.x - start) / job.step - 0.5);
+    if first >= f32(MAX_MARCH) {
+        return false;
+    }
+    for (var k = u32(max(first, 0.0)); k < MAX_MARCH; k++) {
+        let t = start + (f32(k) + 0.5) * job.step;
+        if t >= end {
+            break;
+        }
         let p = ray.origin + ray.dir * t;
         if nearest_code(r, to_voxel(r, p)) == job.label && !in_hole(r, p) {
             return true;
         }
-        t += job.step;
     }
     return false;
 }

@@ -8,7 +8,10 @@
 //! 1. **Feature mask** on a coarse grid over the image ([`FIELD_ROWS`] rows): a cell is
 //!    inside when the camera's own ray through its centre meets a voxel of the feature
 //!    (a label of a label volume), found by marching the label volume with nearest
-//!    sampling every half voxel.
+//!    sampling every half voxel. The march crosses only the label's box (the bricks
+//!    whose code range holds it, [`crate::volume::BrickGrid::code_box`], a voxel
+//!    wider): the samples outside it cannot meet the label, so the mask is the whole
+//!    march's, and rays that miss the box take none.
 //! 2. **Distance transform** of the mask: the exact Euclidean distance of every cell to
 //!    the nearest inside cell and, inside, to the nearest outside cell (Felzenszwalb and
 //!    Huttenlocher's separable lower-envelope algorithm), turned into a signed distance
@@ -26,12 +29,12 @@
 //! Because the centre is only known after the mask, a feature lens takes its focus
 //! depth on the view axis (through the image centre), not through its centroid.
 
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::screen::Screen;
-use crate::region::{Camera, RenderScene};
+use crate::region::{Camera, Plane, RenderScene, box_planes, ray_convex};
 
 /// Rows of the feature grid (columns follow the aspect ratio).
 pub const FIELD_ROWS: u32 = 96;
@@ -84,27 +87,49 @@ impl FeatureGrid {
 
 /// What the GPU needs to find a feature's silhouette: the region holding the label
 /// volume (index among the scene's regions), the label, the marching step (world units,
-/// half the finest voxel spacing) and the grid.
+/// half the finest voxel spacing), the grid, and the world planes of a box outside
+/// which no sample meets the label (`None`: the volume holds none of it).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FeatureJob {
     pub region: u32,
     pub label: u32,
     pub step: f32,
     pub grid: FeatureGrid,
+    pub within: Option<[Plane; 6]>,
 }
+
+/// Voxels the box a mask marches is widened by on every side, beyond the bricks that
+/// can hold the label (so rounding at its faces cannot lose a sample of it).
+const WITHIN_MARGIN: f32 = 1.0;
 
 impl FeatureJob {
     /// The job of `feature` in `scene` over `screen`; `None` when no region shows it.
     pub fn new(scene: &RenderScene, feature: &FeatureRef, screen: Screen) -> Option<FeatureJob> {
         let region = feature_region(scene, feature)?;
         let volume = scene.volumes.get(scene.regions[region].volume)?;
+        let world_to_voxel = &scene.regions[region].world_to_voxel;
+        let within = volume
+            .bricks()
+            .code_box(feature.label)
+            .and_then(|(lo, hi)| box_planes(world_to_voxel, lo - WITHIN_MARGIN, hi + WITHIN_MARGIN).try_into().ok());
         Some(FeatureJob {
             region: region as u32,
             label: feature.label,
             step: 0.5 * volume.grid.min_spacing(),
             grid: FeatureGrid::of(screen),
+            within,
         })
     }
+}
+
+/// Where a mask's march of the samples `start + (k + ½)·step` (k = 0, 1, …) begins on a
+/// ray that enters the label's box at `entry` (`shaders/feature.wgsl` does the same):
+/// the last k before the entry (0 where the ray starts inside), so that rounding cannot
+/// lose a sample inside the box; the samples after it are those a march from `start`
+/// takes.
+pub fn first_sample(start: f32, entry: f32, step: f32) -> u32 {
+    let k = ((entry - start) / step - 0.5).floor();
+    if k.is_nan() || k <= 0.0 { 0 } else { k.min(u32::MAX as f32) as u32 }
 }
 
 /// A feature's silhouette in one view: its signed distance field on the grid.
@@ -282,6 +307,7 @@ pub fn feature_mask(scene: &RenderScene, job: &FeatureJob, camera: &Camera, scre
     let (cols, rows) = (job.grid.cols, job.grid.rows);
     let Some(region) = scene.regions.get(job.region as usize) else { return vec![false; job.grid.cells()] };
     let Some(volume) = scene.volumes.get(region.volume) else { return vec![false; job.grid.cells()] };
+    let Some(within) = job.within else { return vec![false; job.grid.cells()] };
     let sampler = volume.sampler();
     let (label, step) = (job.label, job.step);
     (0..rows * cols)
@@ -291,16 +317,14 @@ pub fn feature_mask(scene: &RenderScene, job: &FeatureJob, camera: &Camera, scre
             let px = (x as f32 + 0.5) / cols as f32 * screen.width;
             let py = (y as f32 + 0.5) / rows as f32 * screen.height;
             let ray = camera.ray(px, py, screen.width as u32, screen.height as u32);
+            let Some((entry, exit)) = ray_convex(&within, ray.origin, ray.dir) else { return false };
             region.intersect(ray.origin, ray.dir).into_iter().any(|(t0, t1)| {
-                let mut t = t0.max(0.0) + 0.5 * step;
-                while t < t1 {
-                    let q: Vec3 = region.world_to_voxel.transform_point3(ray.at(t));
-                    if sampler.nearest(q) as u32 == label {
-                        return true;
-                    }
-                    t += step;
-                }
-                false
+                let start = t0.max(0.0);
+                let end = t1.min(exit);
+                (first_sample(start, entry, step)..)
+                    .map(|k| start + (k as f32 + 0.5) * step)
+                    .take_while(|&t| t < end)
+                    .any(|t| sampler.nearest(region.world_to_voxel.transform_point3(ray.at(t))) as u32 == label)
             })
         })
         .collect()
@@ -369,6 +393,69 @@ mod tests {
         let full = FeatureField::from_mask(&vec![true; mask.len()], grid).unwrap();
         assert!(full.distance.iter().all(|d| d.is_finite() && *d < 0.0));
         assert!(full.distance_at(Vec2::ZERO).is_finite() && full.distance_at(Vec2::new(3.0, 0.0)).is_finite());
+    }
+
+    #[test]
+    fn the_first_sample_is_the_last_before_the_entry() {
+        // Samples at 1 + (k + ½)·2 = 2, 4, 6, …: entering at 7 the march starts at k = 2
+        // (t = 6), at 6 exactly at k = 2 (t = 6: one before rounding can), before the
+        // start at k = 0.
+        assert_eq!(first_sample(1.0, 7.0, 2.0), 2);
+        assert_eq!(first_sample(1.0, 6.0, 2.0), 2);
+        assert_eq!(first_sample(1.0, 6.5, 2.0), 2);
+        assert_eq!(first_sample(1.0, 8.1, 2.0), 3);
+        assert_eq!(first_sample(1.0, -5.0, 2.0), 0);
+        assert_eq!(first_sample(1.0, f32::NEG_INFINITY, 2.0), 0);
+    }
+
+    #[test]
+    fn the_label_box_leaves_every_mask_as_the_whole_march() {
+        use crate::region::Orbit;
+        use crate::scene::load::{load_datasets, render_scene};
+        use glam::Vec3;
+        let file =
+            crate::scene::SceneFile::parse("(datasets: [(source: PhantomLabels(resolution: 48), appearance: (labels: Some(())))])", "t")
+                .unwrap();
+        let datasets = load_datasets(&file, std::path::Path::new(".")).unwrap();
+        let scene = render_scene(&datasets, &file);
+        let screen = Screen::new(96, 96);
+        let ventricles = FeatureRef { label: crate::volume::phantom::head::label::VENTRICLES as u32, region: None };
+        let job = FeatureJob::new(&scene, &ventricles, screen).unwrap();
+        // The whole march: a box that holds the volume.
+        let region = &scene.regions[job.region as usize];
+        let dims = scene.volumes[region.volume].grid.dims.as_vec3();
+        let everywhere = box_planes(&region.world_to_voxel, Vec3::splat(-1.0), dims).try_into().ok();
+        let whole = FeatureJob { within: everywhere, ..job };
+        let (centre, radius) = scene.bounding_sphere();
+        let (mut inside, mut missed) = (0, 0);
+        for (azimuth, elevation) in [(0.0, 0.0), (37.0, 20.0), (90.0, -10.0), (200.0, 60.0)] {
+            let camera = Orbit {
+                target: centre,
+                azimuth_deg: azimuth,
+                elevation_deg: elevation,
+                distance: 3.0 * radius,
+                projection: crate::region::Projection::Perspective { fov_y: 30f32.to_radians() },
+            }
+            .camera();
+            let mask = feature_mask(&scene, &job, &camera, screen);
+            assert_eq!(mask, feature_mask(&scene, &whole, &camera, screen), "azimuth {azimuth}");
+            inside += mask.iter().filter(|m| **m).count();
+            let within = job.within.unwrap();
+            missed += (0..job.grid.cells() as u32)
+                .filter(|i| {
+                    let (x, y) = (i % job.grid.cols, i / job.grid.cols);
+                    let ray =
+                        camera.ray((x as f32 + 0.5) / job.grid.cols as f32 * 96.0, (y as f32 + 0.5) / job.grid.rows as f32 * 96.0, 96, 96);
+                    ray_convex(&within, ray.origin, ray.dir).is_none()
+                })
+                .count();
+        }
+        // The ventricles are in view, and most rays miss their box (and march nothing).
+        assert!(inside > 100, "{inside}");
+        assert!(missed > 2 * job.grid.cells(), "{missed} of {}", 4 * job.grid.cells());
+        // A label the volume lacks has no box and an empty mask.
+        let absent = FeatureJob::new(&scene, &FeatureRef { label: 200, region: None }, screen).unwrap();
+        assert!(absent.within.is_none());
     }
 
     #[test]

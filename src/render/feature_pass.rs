@@ -38,7 +38,10 @@ struct FeatureParams {
     origin: [f32; 2],
     cell: [f32; 2],
     step: f32,
-    pad: [f32; 3],
+    // 1 where the volume holds the label (`within` then holds its box's planes).
+    present: u32,
+    pad: [f32; 2],
+    within: [[f32; 4]; 6],
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,6 +89,8 @@ fn plan(jobs: &[(u32, FeatureJob)], region_slots: &[Option<u32>]) -> (Vec<Dispat
             origin: g.origin.to_array(),
             cell: g.step.to_array(),
             step: job.step,
+            present: u32::from(job.within.is_some()),
+            within: job.within.map_or([[0.0; 4]; 6], |planes| planes.map(|p| p.normal.extend(p.offset).to_array())),
             ..Default::default()
         };
         let groups = UVec2::new(g.cols.div_ceil(GROUP), g.rows.div_ceil(GROUP));
@@ -310,7 +315,13 @@ mod tests {
     #[test]
     fn every_job_on_the_gpu_gets_mask_floods_and_finish() {
         let grid = FeatureGrid::of(Screen::new(100, 100));
-        let job = |region| FeatureJob { region, label: 3, step: 0.5, grid };
+        let unit = crate::region::box_planes(&bevy::math::Affine3A::IDENTITY, Vec3::ZERO, Vec3::ONE);
+        let within: Option<[crate::region::Plane; 6]> = unit.try_into().ok();
+        let job = |region| FeatureJob { region, label: 3, step: 0.5, grid, within };
+        let (_, bytes) = plan(&[(0, job(0)), (9220, job(1)), (0, FeatureJob { within: None, ..job(1) })], &[None, Some(0)]);
+        // A label the volume lacks marches nothing (its mask is empty).
+        let last = *bytemuck::from_bytes::<FeatureParams>(&bytes[bytes.len() - PARAMS_STRIDE as usize..][..size_of::<FeatureParams>()]);
+        assert_eq!(last.present, 0);
         let (dispatches, bytes) = plan(&[(0, job(0)), (9220, job(1))], &[None, Some(0)]);
         // The first job's region was dropped: only the second runs, counters in slot 1.
         let n = flood_steps(&grid).len();
@@ -323,6 +334,8 @@ mod tests {
         };
         let first = params(&dispatches[0]);
         assert_eq!((first.offset, first.region, first.slot, first.label), (9220, 0, 1, 3));
+        // The label's box: the unit cube's planes (n, d), x ≤ 1 first.
+        assert_eq!((first.present, first.within[0], first.within[1]), (1, [1.0, 0.0, 0.0, 1.0], [-1.0, 0.0, 0.0, 0.0]));
         // Flood passes alternate buffers; finish reads the one written last.
         assert_eq!(params(&dispatches[1]).source, 0);
         assert_eq!(params(&dispatches[2]).source, 1);

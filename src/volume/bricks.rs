@@ -87,6 +87,22 @@ impl BrickGrid {
         (b.as_vec3() * s - 0.5, (b.as_vec3() + 1.0) * s - 0.5)
     }
 
+    /// The continuous voxel-index box around every brick whose code range holds `code`
+    /// (the union of their [`Self::brick_bounds`]): every sample position whose nearest
+    /// voxel has that code lies inside it. `None` when no brick's range holds it.
+    pub fn code_box(&self, code: u32) -> Option<(Vec3, Vec3)> {
+        let (mut lo, mut hi) = (UVec3::MAX, UVec3::ZERO);
+        for (i, (&mn, &mx)) in self.min.iter().zip(&self.max).enumerate() {
+            if u32::from(mn) <= code && code <= u32::from(mx) {
+                let i = i as u32;
+                let b = UVec3::new(i % self.dims.x, i / self.dims.x % self.dims.y, i / (self.dims.x * self.dims.y));
+                lo = lo.min(b);
+                hi = hi.max(b);
+            }
+        }
+        (lo.x <= hi.x).then(|| (self.brick_bounds(lo).0, self.brick_bounds(hi).1))
+    }
+
     /// Code range of brick `b`.
     #[inline]
     pub fn range(&self, b: UVec3) -> (u16, u16) {
@@ -186,6 +202,28 @@ fn range_of<T: Copy + Into<u16> + Ord>(v: &[T], dims: UVec3, lo: UVec3, hi: UVec
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_code_box_holds_every_voxel_of_the_code() {
+        // 24 × 16 × 8 voxels in bricks of 4: code 7 at voxels (5, 9, 2) and (13, 10, 6).
+        let dims = UVec3::new(24, 16, 8);
+        let mut v = vec![1u8; 24 * 16 * 8];
+        let at = |x: usize, y: usize, z: usize| (z * 16 + y) * 24 + x;
+        v[at(5, 9, 2)] = 7;
+        v[at(13, 10, 6)] = 7;
+        let g = BrickGrid::build(&Voxels::U8(v), dims, 4);
+        // Bricks (1, 2, 0) … (3, 2, 1): x from brick 1 (voxels 4…7) to 3 (12…15), y
+        // brick 2 (8…11), z bricks 0 … 1 (the one-voxel aprons reach no other brick).
+        let (lo, hi) = g.code_box(7).expect("code 7 is there");
+        assert_eq!(lo, Vec3::new(3.5, 7.5, -0.5));
+        assert_eq!(hi, Vec3::new(15.5, 11.5, 7.5));
+        for q in [Vec3::new(5.0, 9.0, 2.0), Vec3::new(13.4, 10.0, 6.4)] {
+            assert!(q.cmpge(lo).all() && q.cmplt(hi).all(), "{q}");
+        }
+        assert_eq!(g.code_box(1), Some((Vec3::splat(-0.5), dims.as_vec3() - 0.5)));
+        assert_eq!(g.code_box(8), None);
+        assert_eq!(g.code_box(70_000), None);
+    }
 
     #[test]
     fn ranges_include_the_trilinear_apron() {
