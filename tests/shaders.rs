@@ -54,7 +54,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 20] = [
+const DEFS: [&str; 21] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -75,6 +75,7 @@ const DEFS: [&str; 20] = [
     "BRICKED_ONLY",
     "OWN_VALUES",
     "INSETS",
+    "SEVERAL_INSETS",
 ];
 
 #[test]
@@ -114,10 +115,14 @@ fn every_shader_variant_composes_and_validates() {
     };
     // Windows drawn in place touch the DVR loop alone: with DVR and up to two other
     // defs, and with all of them.
-    let insets = bit("INSETS");
+    // (With one window or several: the choice among them alone differs.)
+    let insets = bit("INSETS") | bit("SEVERAL_INSETS");
     let possible = |bits: u32| {
         let others = (bits & !insets & !bit("HAS_DVR")).count_ones();
-        possible(bits) && (bits & insets == 0 || (needs("INSETS", "HAS_DVR", bits) && (others <= 2 || bits == full & !bit("HAS_HOLES"))))
+        possible(bits)
+            && needs("SEVERAL_INSETS", "INSETS", bits)
+            && (bits & insets == 0
+                || (needs("INSETS", "HAS_DVR", bits) && (others <= 2 || bits & !insets == full & !insets & !bit("HAS_HOLES"))))
     };
     let variants: Vec<u32> = (0u32..(1 << DEFS.len())).filter(|b| possible(*b)).collect();
     // (On every core: the variants are independent, and one after another they were

@@ -110,6 +110,10 @@ pub mod features {
     /// Some region draws clip windows in place (`render::pack::insets`; the windows:
     /// [`super::GpuSceneInfo::insets`]).
     pub const INSETS: u32 = 1 << 25;
+    /// More than one window drawn in place: each sample chooses among all
+    /// [`super::MAX_INSETS`] (with one, it compares with that one alone: on llvmpipe
+    /// the other three's comparisons cost a one-window view about 4 % of its frame).
+    pub const SEVERAL_INSETS: u32 = 1 << 26;
 
     /// Shader def names of the lens kinds and shapes, by bit.
     pub const LENS_NAMES: [(u32, &str); 5] = [
@@ -121,7 +125,7 @@ pub mod features {
     ];
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 20] = [
+    pub const NAMES: [(u32, &str); 21] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -142,6 +146,7 @@ pub mod features {
         (BRICKED_ONLY, "BRICKED_ONLY"),
         (OWN_VALUES, "OWN_VALUES"),
         (INSETS, "INSETS"),
+        (SEVERAL_INSETS, "SEVERAL_INSETS"),
     ];
 }
 

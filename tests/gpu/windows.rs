@@ -71,7 +71,7 @@ pub fn clip_windows_drawn_in_place_match_the_reference(gpu: &mut Gpu) {
     let g = gpu.off.capture().unwrap();
     let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
     let packed = focal::render::pack::pack(&scene, 2048).unwrap();
-    let wanted = features::INSETS | features::HOLES;
+    let wanted = features::INSETS | features::SEVERAL_INSETS | features::HOLES;
     assert_eq!(packed.features & wanted, wanted, "four windows in place, the MIP one a hole");
     assert_eq!(packed.insets.len(), 4);
     assert_eq!(packed.region_count, 2, "the head and the MIP window");

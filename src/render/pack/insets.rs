@@ -129,7 +129,12 @@ pub fn kept_holes(prepared: &[PreparedRegion], insets: &[Inset]) -> Vec<Vec<[Pla
 
 /// The shader features of the windows drawn in place, `insets`.
 pub fn inset_features(insets: &[GpuInset]) -> u32 {
-    if insets.is_empty() { 0 } else { super::super::gpu_types::features::INSETS }
+    use super::super::gpu_types::features::{INSETS, SEVERAL_INSETS};
+    match insets.len() {
+        0 => 0,
+        1 => INSETS,
+        _ => INSETS | SEVERAL_INSETS,
+    }
 }
 
 #[cfg(test)]
@@ -186,13 +191,15 @@ mod tests {
         assert_eq!(packed.insets, vec![GpuInset { planes: box_, host: 0, lut_offset: window.lut_offset }]);
         assert_ne!(host.lut_offset, window.lut_offset);
         assert_eq!((host.lut_width, host.lut_a, host.lut_b), (window.lut_width, window.lut_a, window.lut_b));
-        assert_eq!(packed.features & (features::INSETS | features::HOLES), features::INSETS);
+        // (One window: each sample compares with it alone.)
+        assert_eq!(packed.features & (features::INSETS | features::SEVERAL_INSETS | features::HOLES), features::INSETS);
         // It skips only bricks where neither look draws.
         let words = |r: &GpuRegion| packed.occupancy[r.occupancy_offset as usize..][..3 * 8usize.div_ceil(32)].to_vec();
         assert!(words(&host).iter().zip(words(&window)).all(|(h, w)| h & w == w));
         // Four windows: four insets, each its own box.
         let packed = pack(&scene(&FOUR, &bone), 2048).unwrap();
         assert_eq!((packed.region_count, packed.insets.len()), (1, 4));
+        assert_eq!(packed.features & (features::INSETS | features::SEVERAL_INSETS), features::INSETS | features::SEVERAL_INSETS);
         assert!(packed.insets.iter().all(|i| i.host == 0));
         assert!((1..4).all(|k| packed.insets[k].planes != packed.insets[0].planes));
     }

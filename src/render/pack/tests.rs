@@ -398,3 +398,69 @@ fn context_preserving_dvr_at_kappa_t_zero_takes_dvrs_cost_path() {
     };
     assert_eq!(with(0.0, lambda).regions[0].mode, mode::CONTEXT);
 }
+
+#[test]
+fn a_part_record_is_its_regions_but_for_its_look() {
+    // The shader reads a part's look and takes the rest from its segmented region's
+    // record (two_level.wgsl part_record): every other field the march reads of a part
+    // must be the region's.
+    use crate::region::{Object, Segmentation};
+    use crate::volume::phantom::head::{self, label};
+    let h = head::generate(32).unwrap();
+    let ct = Arc::new(h.ct);
+    let rest = Appearance::new(Mode::Context, presets::builtin("ct_skin_bone").unwrap());
+    let shaded = Appearance { shading: crate::region::Shading { enabled: false, ..Default::default() }, ..rest.clone() };
+    let objects = vec![
+        Object::new("arteries", vec![label::ARTERIES as u32], Appearance::new(Mode::Dvr, presets::builtin("ct_vessels").unwrap())),
+        Object::new("skull", vec![label::SKULL as u32], Appearance::new(Mode::Mip, presets::builtin("grayscale_ramp").unwrap())),
+        Object::new("ventricles", vec![label::VENTRICLES as u32], Appearance::new(Mode::Iso, presets::builtin("grayscale_ramp").unwrap())),
+        Object::new("brain", vec![label::GREY_MATTER as u32, label::WHITE_MATTER as u32], shaded),
+    ];
+    for own_values in [false, true] {
+        let segmented = Appearance {
+            segmentation: Some(Segmentation {
+                labels: Arc::new(h.labels.volume.clone()),
+                table: None,
+                objects: objects.clone(),
+                rest_visible: true,
+                own_values,
+            }),
+            ..rest.clone()
+        };
+        let packed = pack(&RenderScene::single(ct.clone(), segmented), 2048).unwrap();
+        let region = packed.regions[0];
+        assert_eq!(region.mode, mode::TWO_LEVEL);
+        let first = region.objects.x as usize;
+        let parts = &packed.regions[first..first + region.objects.y as usize];
+        assert_eq!(parts.len(), 5);
+        let modes: Vec<u32> = parts.iter().map(|p| p.mode).collect();
+        assert_eq!(modes, [mode::DVR, mode::MIP, mode::ISO, mode::CONTEXT, mode::CONTEXT]);
+        for part in parts {
+            let look = GpuRegion {
+                mode: part.mode,
+                flags: part.flags,
+                lut_offset: part.lut_offset,
+                lut_width: part.lut_width,
+                lut_a: part.lut_a,
+                lut_b: part.lut_b,
+                iso: part.iso,
+                shading: part.shading,
+                context: part.context,
+                projection: part.projection,
+                // (Read of the part's own record, or never read of a part.)
+                value_lo: part.value_lo,
+                value_hi: part.value_hi,
+                plane_offset: part.plane_offset,
+                plane_count: part.plane_count,
+                hole_offset: part.hole_offset,
+                hole_count: part.hole_count,
+                occupancy_offset: part.occupancy_offset,
+                bounds: part.bounds,
+                cluster: part.cluster,
+                objects: part.objects,
+                ..region
+            };
+            assert_eq!(*part, look, "own values {own_values}");
+        }
+    }
+}
