@@ -54,7 +54,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 21] = [
+const DEFS: [&str; 22] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -76,6 +76,7 @@ const DEFS: [&str; 21] = [
     "OWN_VALUES",
     "INSETS",
     "SEVERAL_INSETS",
+    "VALUE_RANGES",
 ];
 
 #[test]
@@ -123,6 +124,14 @@ fn every_shader_variant_composes_and_validates() {
             && needs("SEVERAL_INSETS", "INSETS", bits)
             && (bits & insets == 0
                 || (needs("INSETS", "HAS_DVR", bits) && (others <= 2 || bits & !insets == full & !insets & !bit("HAS_HOLES"))))
+    };
+    // Objects' value ranges sit in the two-level code alone, as own values do.
+    let ranges = bit("VALUE_RANGES");
+    let possible = |bits: u32| {
+        possible(bits)
+            && (bits & ranges == 0
+                || (bits & bit("HAS_TWO_LEVEL") != 0
+                    && ((bits & !ranges).count_ones() <= 3 || (bits | bricked | bit("HAS_HOLES") | insets) == full)))
     };
     let variants: Vec<u32> = (0u32..(1 << DEFS.len())).filter(|b| possible(*b)).collect();
     // (On every core: the variants are independent, and one after another they were

@@ -114,6 +114,10 @@ pub mod features {
     /// [`super::MAX_INSETS`] (with one, it compares with that one alone: on llvmpipe
     /// the other three's comparisons cost a one-window view about 4 % of its frame).
     pub const SEVERAL_INSETS: u32 = 1 << 26;
+    /// Some object of a segmented region takes only a range of values: a sample's part
+    /// is the first of its label's candidates whose range holds its value (without, the
+    /// first candidate: no object's range is read).
+    pub const VALUE_RANGES: u32 = 1 << 27;
 
     /// Shader def names of the lens kinds and shapes, by bit.
     pub const LENS_NAMES: [(u32, &str); 5] = [
@@ -125,7 +129,7 @@ pub mod features {
     ];
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 21] = [
+    pub const NAMES: [(u32, &str); 22] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -147,6 +151,7 @@ pub mod features {
         (OWN_VALUES, "OWN_VALUES"),
         (INSETS, "INSETS"),
         (SEVERAL_INSETS, "SEVERAL_INSETS"),
+        (VALUE_RANGES, "VALUE_RANGES"),
     ];
 }
 

@@ -182,6 +182,9 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.features |= super::gpu_types::features::COMPANION;
     }
     out.features |= inset_features(&out.insets);
+    if prepared.iter().filter_map(|p| p.objects.as_ref()).any(|o| o.table.ranges.iter().any(|&r| r != (f32::NEG_INFINITY, f32::INFINITY))) {
+        out.features |= super::gpu_types::features::VALUE_RANGES;
+    }
     if channels.is_some() && out.features & super::gpu_types::features::SELECTION != 0 {
         out.features |= super::gpu_types::features::DOI_CHANNEL;
     }

@@ -44,9 +44,20 @@ pub fn two_level_matches_the_reference(gpu: &mut Gpu) {
     let g = gpu.show(ct.clone(), a.clone(), &cam);
     assert_matches("two_level_head", &g, &cpu(ct.clone(), a.clone(), &cam));
     // The objects change the picture: the same CT without them differs.
-    let plain = gpu.show(ct, Appearance { segmentation: None, ..a }, &cam);
+    let plain = gpu.show(ct.clone(), Appearance { segmentation: None, ..a.clone() }, &cam);
     let (mean, _, _) = difference(&plain, &g);
     assert!(mean > 2.0, "the segmentation changed little (mean {mean})");
+    // A range of values (the shader's VALUE_RANGES): the skull's samples below 600 HU,
+    // its partial-volume shell, are the rest's.
+    let mut ranged = a.clone();
+    if let Some(seg) = ranged.segmentation.as_mut() {
+        seg.objects[1].values = Some((600.0, 3000.0));
+    }
+    let r = gpu.show(ct.clone(), ranged.clone(), &cam);
+    assert_matches("two_level_ranges", &r, &cpu(ct, ranged, &cam));
+    let changed = r.pixels().zip(g.pixels()).filter(|(p, q)| (0..3).any(|k| p[k].abs_diff(q[k]) > 10)).count();
+    println!("    the skull's range changed {changed} pixels");
+    assert!(changed > 50, "the skull's range changed only {changed} pixels");
 }
 
 pub fn overlapping_two_level_regions_match_the_reference(gpu: &mut Gpu) {

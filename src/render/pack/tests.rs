@@ -404,6 +404,7 @@ fn a_part_record_is_its_regions_but_for_its_look() {
     // The shader reads a part's look and takes the rest from its segmented region's
     // record (two_level.wgsl part_record): every other field the march reads of a part
     // must be the region's.
+    use super::super::gpu_types::features;
     use crate::region::{Object, Segmentation};
     use crate::volume::phantom::head::{self, label};
     let h = head::generate(32).unwrap();
@@ -462,5 +463,24 @@ fn a_part_record_is_its_regions_but_for_its_look() {
             };
             assert_eq!(*part, look, "own values {own_values}");
         }
+        // No object takes a range of values: the shader reads no range.
+        assert_eq!(packed.features & features::VALUE_RANGES, 0);
     }
+    // The skull's bone alone: its range is read.
+    let mut ranged = objects.clone();
+    ranged[1].values = Some((300.0, 3000.0));
+    let segmented = Appearance {
+        segmentation: Some(Segmentation {
+            labels: Arc::new(h.labels.volume.clone()),
+            table: None,
+            objects: ranged,
+            rest_visible: true,
+            own_values: false,
+        }),
+        ..rest.clone()
+    };
+    let packed = pack(&RenderScene::single(ct.clone(), segmented), 2048).unwrap();
+    assert_eq!(packed.features & features::VALUE_RANGES, features::VALUE_RANGES);
+    let skull = packed.regions[packed.regions[0].objects.x as usize + 1];
+    assert!(skull.value_lo > 0.0 && skull.value_hi < 1.0, "{} {}", skull.value_lo, skull.value_hi);
 }
