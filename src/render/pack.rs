@@ -168,6 +168,10 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
     }
     // Records the ray does not traverse: the parts and labels of segmented regions, the
     // selections of weighted ones.
+    // (Ranges of the objects of the regions drawn: without, no sample reads one.)
+    let ranged =
+        |p: &PreparedRegion| p.objects.as_ref().is_some_and(|o| o.table.ranges.iter().any(|&r| r != (f32::NEG_INFINITY, f32::INFINITY)));
+    let value_ranges = segmented.iter().any(|(_, p, _)| ranged(p));
     for (index, p, slots) in segmented {
         let objects = pack_objects(p, &slots, &mut out);
         out.regions[index].objects = objects;
@@ -182,7 +186,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.features |= super::gpu_types::features::COMPANION;
     }
     out.features |= inset_features(&out.insets);
-    if prepared.iter().filter_map(|p| p.objects.as_ref()).any(|o| o.table.ranges.iter().any(|&r| r != (f32::NEG_INFINITY, f32::INFINITY))) {
+    if value_ranges {
         out.features |= super::gpu_types::features::VALUE_RANGES;
     }
     if channels.is_some() && out.features & super::gpu_types::features::SELECTION != 0 {

@@ -448,7 +448,9 @@ fn a_part_record_is_its_regions_but_for_its_look() {
                 shading: part.shading,
                 context: part.context,
                 projection: part.projection,
-                // (Read of the part's own record, or never read of a part.)
+                // (Read of the part's own record, or never read of a part: its step
+                // is the region's, `ratios`.)
+                native_step: part.native_step,
                 value_lo: part.value_lo,
                 value_hi: part.value_hi,
                 plane_offset: part.plane_offset,
