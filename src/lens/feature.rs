@@ -395,6 +395,17 @@ mod tests {
         assert!(full.distance_at(Vec2::ZERO).is_finite() && full.distance_at(Vec2::new(3.0, 0.0)).is_finite());
     }
 
+    /// A scene of the labelled head phantom (48³) shown as labels.
+    fn labelled_head() -> (crate::scene::SceneFile, Vec<crate::scene::load::LoadedDataset>, RenderScene) {
+        use crate::scene::load::{load_datasets, render_scene};
+        let file =
+            crate::scene::SceneFile::parse("(datasets: [(source: PhantomLabels(resolution: 48), appearance: (labels: Some(())))])", "t")
+                .unwrap();
+        let datasets = load_datasets(&file, std::path::Path::new(".")).unwrap();
+        let scene = render_scene(&datasets, &file);
+        (file, datasets, scene)
+    }
+
     #[test]
     fn the_first_sample_is_the_last_before_the_entry() {
         // Samples at 1 + (k + ½)·2 = 2, 4, 6, …: entering at 7 the march starts at k = 2
@@ -411,13 +422,8 @@ mod tests {
     #[test]
     fn the_label_box_leaves_every_mask_as_the_whole_march() {
         use crate::region::Orbit;
-        use crate::scene::load::{load_datasets, render_scene};
         use glam::Vec3;
-        let file =
-            crate::scene::SceneFile::parse("(datasets: [(source: PhantomLabels(resolution: 48), appearance: (labels: Some(())))])", "t")
-                .unwrap();
-        let datasets = load_datasets(&file, std::path::Path::new(".")).unwrap();
-        let scene = render_scene(&datasets, &file);
+        let (_, _, scene) = labelled_head();
         let screen = Screen::new(96, 96);
         let ventricles = FeatureRef { label: crate::volume::phantom::head::label::VENTRICLES as u32, region: None };
         let job = FeatureJob::new(&scene, &ventricles, screen).unwrap();
@@ -462,12 +468,8 @@ mod tests {
     fn a_feature_lens_bends_the_rays_through_its_silhouette() {
         use crate::lens::stack::{lens_ray, resolve_in};
         use crate::lens::{Lens, Shape};
-        use crate::scene::load::{camera, load_datasets, render_scene, visible_bounds};
-        let file =
-            crate::scene::SceneFile::parse("(datasets: [(source: PhantomLabels(resolution: 48), appearance: (labels: Some(())))])", "t")
-                .unwrap();
-        let datasets = load_datasets(&file, std::path::Path::new(".")).unwrap();
-        let scene = render_scene(&datasets, &file);
+        use crate::scene::load::{camera, visible_bounds};
+        let (file, datasets, scene) = labelled_head();
         let cam = camera(&file.camera, visible_bounds(&datasets), 1.0);
         let screen = Screen::new(120, 120);
         let ventricles = FeatureRef { label: crate::volume::phantom::head::label::VENTRICLES as u32, region: None };
