@@ -477,7 +477,7 @@ impl Segmentation {
             .iter()
             .map(|o| match o.values {
                 Some((lo, hi)) => (data.real_to_normalized(lo) as f32, data.real_to_normalized(hi) as f32),
-                None => (f32::NEG_INFINITY, f32::INFINITY),
+                None => ObjectTable::UNBOUNDED,
             })
             .collect();
         ObjectTable { candidates, ranges }
@@ -575,6 +575,14 @@ pub struct ObjectTable {
 }
 
 impl ObjectTable {
+    /// The range of an object without one: every value.
+    pub const UNBOUNDED: (f32, f32) = (f32::NEG_INFINITY, f32::INFINITY);
+
+    /// Whether some object takes only a range of values.
+    pub fn has_ranges(&self) -> bool {
+        self.ranges.iter().any(|&r| r != Self::UNBOUNDED)
+    }
+
     /// The object of a sample with label `code` and normalised data value `v`
     /// (`None`: the rest).
     pub fn object(&self, code: u16, v: f32) -> Option<usize> {

@@ -19,7 +19,7 @@ use crate::volume::pyramid::{MIP_LEVELS, half_dims};
 use super::gpu_types::{CLUSTER, GpuRegion, context_power, mode, region_flags};
 use crate::context::Power;
 use crate::reference::prepare::{PreparedLookup, PreparedRegion};
-use crate::region::{Mode, Plane, RenderScene, meet};
+use crate::region::{Mode, ObjectTable, Plane, RenderScene, meet};
 
 /// Dimensions of a volume's boxes in the atlas: the volume, then (with `mips`) its levels.
 fn volume_boxes(dims: UVec3, mips: bool) -> Vec<UVec3> {
@@ -169,9 +169,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
     // Records the ray does not traverse: the parts and labels of segmented regions, the
     // selections of weighted ones.
     // (Ranges of the objects of the regions drawn: without, no sample reads one.)
-    let ranged =
-        |p: &PreparedRegion| p.objects.as_ref().is_some_and(|o| o.table.ranges.iter().any(|&r| r != (f32::NEG_INFINITY, f32::INFINITY)));
-    let value_ranges = segmented.iter().any(|(_, p, _)| ranged(p));
+    let value_ranges = segmented.iter().any(|(_, p, _)| p.objects.as_ref().is_some_and(|o| o.table.has_ranges()));
     for (index, p, slots) in segmented {
         let objects = pack_objects(p, &slots, &mut out);
         out.regions[index].objects = objects;
@@ -220,7 +218,7 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
     let data_levels = out.levels[slots[0]].clone();
     for (k, part) in objects.parts.iter().enumerate() {
         let mut r = pack_region(part, &part.region.holes, &data_levels, out.brick_atlas.offsets[slots[0]], out);
-        (r.value_lo, r.value_hi) = objects.table.ranges.get(k).copied().unwrap_or((f32::NEG_INFINITY, f32::INFINITY));
+        (r.value_lo, r.value_hi) = objects.table.ranges.get(k).copied().unwrap_or(ObjectTable::UNBOUNDED);
         // Infinities do not survive every path to the GPU: the largest finite floats.
         (r.value_lo, r.value_hi) = (r.value_lo.max(f32::MIN), r.value_hi.min(f32::MAX));
         if !objects.visible[k] {

@@ -417,18 +417,18 @@ fn a_part_record_is_its_regions_but_for_its_look() {
         Object::new("ventricles", vec![label::VENTRICLES as u32], Appearance::new(Mode::Iso, presets::builtin("grayscale_ramp").unwrap())),
         Object::new("brain", vec![label::GREY_MATTER as u32, label::WHITE_MATTER as u32], shaded),
     ];
+    let segmented = |objects: Vec<Object>, own_values: bool| Appearance {
+        segmentation: Some(Segmentation {
+            labels: Arc::new(h.labels.volume.clone()),
+            table: None,
+            objects,
+            rest_visible: true,
+            own_values,
+        }),
+        ..rest.clone()
+    };
     for own_values in [false, true] {
-        let segmented = Appearance {
-            segmentation: Some(Segmentation {
-                labels: Arc::new(h.labels.volume.clone()),
-                table: None,
-                objects: objects.clone(),
-                rest_visible: true,
-                own_values,
-            }),
-            ..rest.clone()
-        };
-        let packed = pack(&RenderScene::single(ct.clone(), segmented), 2048).unwrap();
+        let packed = pack(&RenderScene::single(ct.clone(), segmented(objects.clone(), own_values)), 2048).unwrap();
         let region = packed.regions[0];
         assert_eq!(region.mode, mode::TWO_LEVEL);
         let first = region.objects.x as usize;
@@ -471,17 +471,7 @@ fn a_part_record_is_its_regions_but_for_its_look() {
     // The skull's bone alone: its range is read.
     let mut ranged = objects.clone();
     ranged[1].values = Some((300.0, 3000.0));
-    let segmented = Appearance {
-        segmentation: Some(Segmentation {
-            labels: Arc::new(h.labels.volume.clone()),
-            table: None,
-            objects: ranged,
-            rest_visible: true,
-            own_values: false,
-        }),
-        ..rest.clone()
-    };
-    let packed = pack(&RenderScene::single(ct.clone(), segmented), 2048).unwrap();
+    let packed = pack(&RenderScene::single(ct.clone(), segmented(ranged, false)), 2048).unwrap();
     assert_eq!(packed.features & features::VALUE_RANGES, features::VALUE_RANGES);
     let skull = packed.regions[packed.regions[0].objects.x as usize + 1];
     assert!(skull.value_lo > 0.0 && skull.value_hi < 1.0, "{} {}", skull.value_lo, skull.value_hi);
