@@ -168,8 +168,14 @@ fn read_with(reader: Reader, p: &Path) {
 
 /// Inputs tried by this test binary.
 static TRIED: AtomicUsize = AtomicUsize::new(0);
-/// One case at a time: the allocation counter is global.
+/// One test at a time, from its first allocation to its last: the allocation counter is
+/// global, and a test preparing its inputs (a copy of a file, its mutations) beside
+/// another's case would be counted as that case's.
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
+}
 
 fn run_case(path: &Path, reader: Reader, what: &str) -> Result<(), String> {
     let (tx, rx) = mpsc::channel();
@@ -210,7 +216,6 @@ fn fuzz_cases(
     cases: Vec<(String, Vec<u8>)>,
     keep: &Path,
 ) -> Vec<String> {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let mut failures = Vec::new();
     for (k, (what, b)) in cases.into_iter().enumerate() {
         std::fs::write(target, &b).unwrap();
@@ -270,6 +275,7 @@ fn gzip(bytes: &[u8]) -> Vec<u8> {
 
 #[test]
 fn nifti() {
+    let _serial = serial();
     fuzz("ct/fuel.nii.gz", 1, 60);
     fuzz("mri/ch2.nii.gz", 2, 25);
     // Uncompressed, and the gzip stream itself corrupted inside.
@@ -279,6 +285,7 @@ fn nifti() {
 
 #[test]
 fn nrrd() {
+    let _serial = serial();
     fuzz("mri/FLAIR.nrrd", 3, 40);
     // The other encodings: raw, ascii, gzip, each with its header fuzzed.
     let codes = fuel();
@@ -296,17 +303,20 @@ fn nrrd() {
 
 #[test]
 fn metaimage() {
+    let _serial = serial();
     fuzz("mri/epi_64x64x37.mha", 4, 60);
 }
 
 #[test]
 fn vti() {
+    let _serial = serial();
     fuzz("ct/engine.vti", 5, 40);
     fuzz("labels/frog_tissues.vti", 6, 25);
 }
 
 #[test]
 fn dicom() {
+    let _serial = serial();
     fuzz("dicom/mr_3slices/1-001.dcm", 7, 60);
     fuzz("dicom/enhanced_mr_multiframe.dcm", 8, 60);
     // pydicom's RT Dose grids: big-endian 32-bit, and RLE-coded (Focal's own RLE decoder
@@ -324,12 +334,14 @@ fn dicom() {
 
 #[test]
 fn label_tables() {
+    let _serial = serial();
     fuzz("labels/aal.nii.txt", 9, 40);
     fuzz("labels/aal.nii.lut", 10, 20);
 }
 
 #[test]
 fn volvis_dat_and_raw() {
+    let _serial = serial();
     let codes = fuel();
     let dir = scratch("fuzz-dat");
     std::fs::write(dir.join("fuel.raw"), &codes).unwrap();
@@ -356,6 +368,7 @@ fn volvis_dat_and_raw() {
 
 #[test]
 fn scene_files() {
+    let _serial = serial();
     // Every example scene, parsed and checked (its datasets are not loaded).
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
     let mut names: Vec<_> = std::fs::read_dir(&examples).unwrap().filter_map(|e| e.ok()).map(|e| e.path()).collect();
@@ -374,6 +387,7 @@ fn scene_files() {
 
 #[test]
 fn ome_zarr_metadata_and_chunks() {
+    let _serial = serial();
     use focal::volume::convert::ome_zarr::{Compressor, WriteOptions, ZarrVersion, write};
     let volume = read_volume(&data("ct/fuel.nii.gz"), &ReadOptions::default()).unwrap();
     let mut failures = Vec::new();
@@ -428,6 +442,7 @@ fn fuzz_store(label: &str, dir: &Path, rel: &str, bytes: &[u8], seed: u64) -> Ve
 /// scene where the file ends in `.ron`.
 #[test]
 fn regressions() {
+    let _serial = serial();
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_regressions");
     let mut failures = Vec::new();
     let mut count = 0;
@@ -438,7 +453,6 @@ fn regressions() {
             Some("md") => continue,
             _ => Reader::Volume,
         };
-        let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
         LARGEST.store(0, Ordering::Relaxed);
         if let Err(e) = run_case(&p, reader, &p.display().to_string()) {
             failures.push(e);
@@ -458,6 +472,7 @@ fn regressions() {
 /// name and the numbers it claims, before any buffer for the voxels is made.
 #[test]
 fn headers_claiming_a_trillion_voxels_are_refused_before_any_buffer() {
+    let _serial = serial();
     let dir = scratch("trillion");
     let fuel_nii = gunzip(&std::fs::read(data("ct/fuel.nii.gz")).unwrap());
     let mut nii = fuel_nii[..352].to_vec();
@@ -528,7 +543,6 @@ fn headers_claiming_a_trillion_voxels_are_refused_before_any_buffer() {
     }
     cases.push((store, ReadOptions::default(), "10000"));
 
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let mut failures = Vec::new();
     for (path, options, claim) in &cases {
         let name = path.file_name().unwrap().to_str().unwrap();
