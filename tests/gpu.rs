@@ -446,7 +446,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 38] = [
+    let tests: [GpuTest; 39] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -481,6 +481,7 @@ fn main() {
         ("a_magnifying_window_enlarges_its_source", windows::a_magnifying_window_enlarges_its_source),
         ("an_exploded_head_matches_the_reference", explode::an_exploded_head_matches_the_reference),
         ("eighteen_exploded_parts_match_the_reference", explode::eighteen_exploded_parts_match_the_reference),
+        ("a_hundred_and_fifty_exploded_parts_match_the_reference", explode::a_hundred_and_fifty_exploded_parts_match_the_reference),
         ("a_mip_of_exploded_parts_is_one_maximum_along_the_ray", explode::a_mip_of_exploded_parts_is_one_maximum_along_the_ray),
         ("a_selection_on_its_own_grid_matches_the_reference", explode::a_selection_on_its_own_grid_matches_the_reference),
         ("bricked_ch2_converges_to_the_chosen_level_in_memory", bricked::bricked_ch2_converges_to_the_chosen_level_in_memory),

@@ -17,11 +17,12 @@ struct View {
 const BEVY_FULLSCREEN: &str = "#define_import_path bevy_core_pipeline::fullscreen_vertex_shader
 struct FullscreenVertexOutput { @builtin(position) position: vec4<f32>, @location(0) uv: vec2<f32> }";
 
-const MODULES: [&str; 17] = [
+const MODULES: [&str; 18] = [
     "types",
     "bindings",
     "camera",
     "regions",
+    "headers",
     "bricked",
     "sampling",
     "lens",
@@ -54,7 +55,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 22] = [
+const DEFS: [&str; 23] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -77,6 +78,7 @@ const DEFS: [&str; 22] = [
     "INSETS",
     "SEVERAL_INSETS",
     "VALUE_RANGES",
+    "UNIFORM_HEADERS",
 ];
 
 #[test]
@@ -102,13 +104,15 @@ fn every_shader_variant_composes_and_validates() {
     // them (every combination doubled the test's 3½ minutes), each with and without
     // BRICKED_ONLY.
     let bricked = bit("HAS_BRICKED") | bit("BRICKED_ONLY");
-    let all_but_holes = ((1u32 << DEFS.len()) - 1) & !bricked & !bit("HAS_HOLES");
+    // (The region headers' source: with the interval code's defs alone, below.)
+    let headers = bit("UNIFORM_HEADERS");
+    let full = ((1u32 << DEFS.len()) - 1) & !headers;
+    let all_but_holes = full & !bricked & !bit("HAS_HOLES");
     let possible =
         |bits: u32| possible(bits) && (bits & bricked == 0 || (bits & !bricked).count_ones() <= 2 || bits & !bricked == all_but_holes);
     // Own values at object boundaries sit in the two-level code alone: with it and up to
     // two other defs, and with all of them.
     let own = bit("OWN_VALUES");
-    let full = (1u32 << DEFS.len()) - 1;
     let possible = |bits: u32| {
         possible(bits)
             && (bits & own == 0
@@ -133,6 +137,9 @@ fn every_shader_variant_composes_and_validates() {
                 || (bits & bit("HAS_TWO_LEVEL") != 0
                     && ((bits & !ranges).count_ones() <= 3 || (bits | bricked | bit("HAS_HOLES") | insets) == full)))
     };
+    // The regions' headers read from the uniform buffer change the interval loop
+    // alone: with the defs that share it (and bricked steps), not every other.
+    let possible = |bits: u32| possible(bits & !headers) && (bits & headers == 0 || bits & !(headers | interval_defs | bricked) == 0);
     let variants: Vec<u32> = (0u32..(1 << DEFS.len())).filter(|b| possible(*b)).collect();
     // (On every core: the variants are independent, and one after another they were
     // six of the suite's minutes. A variant that fails panics its thread, and the scope
@@ -195,6 +202,8 @@ fn shader_constants_match_the_renderer() {
     };
     assert_eq!(constant("LUT_ATLAS_WIDTH"), focal::render::pack::LUT_ATLAS_WIDTH);
     assert_eq!(constant("MAX_INSETS") as usize, focal::render::gpu_types::MAX_INSETS);
+    assert_eq!(constant("MAX_HEADERS") as usize, focal::render::gpu_types::MAX_HEADERS);
+    assert_eq!(constant("MAX_HEADER_PLANES") as usize, focal::render::gpu_types::MAX_HEADER_PLANES);
 }
 
 #[test]

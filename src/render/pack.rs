@@ -191,6 +191,9 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.features |= super::gpu_types::features::DOI_CHANNEL;
     }
     out.max_steps = march_bound(&out.regions[..out.region_count as usize], union_extent(&prepared));
+    if super::gpu_types::headers_fit(out.region_count, out.planes.len().max(1)) {
+        out.features |= super::gpu_types::features::UNIFORM_HEADERS;
+    }
     // Empty scenes still bind (1-texel) atlases.
     out.atlas.size = out.atlas.size.max(UVec3::ONE);
     out.brick_atlas.size = out.brick_atlas.size.max(UVec3::ONE);

@@ -15,7 +15,7 @@ use bevy::render::renderer::{RenderAdapter, RenderDevice, RenderQueue};
 use rayon::prelude::*;
 
 use super::extract::ExtractedScene;
-use super::gpu_types::GpuSceneInfo;
+use super::gpu_types::{GpuRegionHeader, GpuSceneInfo, features};
 use super::pack::{LUT_ATLAS_WIDTH, MAX_INSETS, PackedScene, pack};
 use crate::region::RenderScene;
 use crate::volume::{Volume, Voxels};
@@ -326,7 +326,7 @@ fn storage<T: bevy::render::render_resource::ShaderType + bevy::render::render_r
 
 fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScene, gpu: &mut GpuScene) {
     let inv = 1.0 / packed.atlas.size.max(UVec3::ONE).as_vec3();
-    let info = GpuSceneInfo {
+    let mut info = GpuSceneInfo {
         inv_atlas_size: inv.extend(0.0),
         region_count: packed.region_count,
         max_steps: packed.max_steps,
@@ -334,6 +334,14 @@ fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScen
         insets: std::array::from_fn(|i| packed.insets.get(i).copied().unwrap_or_default()),
         ..Default::default()
     };
+    if packed.features & features::UNIFORM_HEADERS != 0 {
+        for (h, r) in info.headers.iter_mut().zip(&packed.regions[..packed.region_count as usize]) {
+            *h = GpuRegionHeader::of(r);
+        }
+        for (to, from) in info.header_planes.iter_mut().zip(&packed.planes) {
+            *to = *from;
+        }
+    }
     let mut ub = UniformBuffer::new(Vec::new());
     let _ = ub.write(&info);
     gpu.info = Some(device.create_buffer_with_data(&BufferInitDescriptor {

@@ -7,6 +7,7 @@ use focal::dataset::SceneRegions;
 use focal::explode::systems::{spawn_part, volume_polyhedron};
 use focal::explode::{Exploded, Part, step};
 use focal::region::Plane;
+use focal::render::gpu_types::features::UNIFORM_HEADERS;
 use focal::volume::SelectionVolume;
 
 /// The selection on the data's grid: its degree of interest rides in the second channel
@@ -121,6 +122,12 @@ fn exploded_halves(gpu: &mut Gpu, carried: bool) {
 /// The head with `look`, exploded around the arteries into 18 parts (a 3×3×2 grid) at
 /// rest and framed obliquely: the dataset and the camera.
 fn eighteen_parts(gpu: &mut Gpu, look: Appearance) -> (Entity, FocalCamera) {
+    grid_parts(gpu, look, (3, 3, 2))
+}
+
+/// The head with `look`, exploded around the arteries into a grid of `cells` parts at
+/// rest and framed obliquely: the dataset and the camera.
+fn grid_parts(gpu: &mut Gpu, look: Appearance, cells: (u32, u32, u32)) -> (Entity, FocalCamera) {
     let ct = head();
     gpu.clear();
     let labels = phantom::head::generate(64).unwrap().labels;
@@ -129,8 +136,8 @@ fn eighteen_parts(gpu: &mut Gpu, look: Appearance) -> (Entity, FocalCamera) {
     let world = gpu.off.world_mut();
     let data = world.spawn((Dataset::new(ct.clone(), look), Transform::default(), Exploded::around(&selection))).id();
     use focal::explode::spec::{ExplodeSpec, PartsSpec, SelectionSpec};
-    let grid = ExplodeSpec { parts: PartsSpec::Grid((3, 3, 2)), ..ExplodeSpec::around(SelectionSpec::Nothing) }.parts(&ct).unwrap();
-    assert_eq!(grid.len(), 18);
+    let grid = ExplodeSpec { parts: PartsSpec::Grid(cells), ..ExplodeSpec::around(SelectionSpec::Nothing) }.parts(&ct).unwrap();
+    assert_eq!(grid.len() as u32, cells.0 * cells.1 * cells.2);
     for rest in grid {
         spawn_part(world, Part::new(data, rest), Transform::default());
     }
@@ -162,6 +169,25 @@ pub fn eighteen_exploded_parts_match_the_reference(gpu: &mut Gpu) {
     gpu.off.capture().unwrap();
     push_apart(gpu, data);
     matches_its_reference(gpu, "eighteen_parts_apart", &cam, 19);
+    assert_ne!(packed_features(gpu) & UNIFORM_HEADERS, 0, "the regions' headers in the uniform buffer");
+    gpu.clear();
+}
+
+fn packed_features(gpu: &mut Gpu) -> u32 {
+    let scene = gpu.off.world_mut().resource::<SceneRegions>().scene.clone();
+    focal::render::pack::pack(&scene, 2048).unwrap().features
+}
+
+/// 150 parts (a 6×5×5 grid) exploded: more traversed regions than the scene's uniform
+/// buffer holds headers for (`render::gpu_types::MAX_HEADERS`), so the interval loop
+/// reads them from the region records in storage; every part is drawn where the
+/// reference draws it.
+pub fn a_hundred_and_fifty_exploded_parts_match_the_reference(gpu: &mut Gpu) {
+    let (data, cam) = grid_parts(gpu, Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap()), (6, 5, 5));
+    gpu.off.capture().unwrap();
+    push_apart(gpu, data);
+    matches_its_reference(gpu, "a_hundred_and_fifty_parts_apart", &cam, 151);
+    assert_eq!(packed_features(gpu) & UNIFORM_HEADERS, 0, "the regions' headers in storage");
     gpu.clear();
 }
 

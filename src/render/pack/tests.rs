@@ -212,7 +212,7 @@ fn packs_regions_planes_luts_and_the_atlas() {
     assert_eq!(packed.lut.len(), LUT_ATLAS_WIDTH as usize);
     assert_eq!(packed.regions[0].dims, glam::Vec4::new(16.0, 16.0, 16.0, 255.0));
     use crate::render::gpu_types::features as f;
-    assert_eq!(packed.features, f::PROJECTION | f::SHADING | f::MULTI_REGION | f::MIP_READS);
+    assert_eq!(packed.features, f::PROJECTION | f::SHADING | f::MULTI_REGION | f::MIP_READS | f::UNIFORM_HEADERS);
     // Regions reading a mip chain: scalar samples of volumes in memory, not label codes,
     // not bricked volumes, not regions that draw nothing.
     let scalar = packed.regions[1];
@@ -475,4 +475,42 @@ fn a_part_record_is_its_regions_but_for_its_look() {
     assert_eq!(packed.features & features::VALUE_RANGES, features::VALUE_RANGES);
     let skull = packed.regions[packed.regions[0].objects.x as usize + 1];
     assert!(skull.value_lo > 0.0 && skull.value_hi < 1.0, "{} {}", skull.value_lo, skull.value_hi);
+}
+
+#[test]
+fn the_interval_loop_reads_headers_from_the_uniform_buffer_while_they_fit() {
+    use super::super::gpu_types::{GpuRegionHeader, MAX_HEADER_PLANES, MAX_HEADERS, features, headers_fit};
+    let v = Arc::new(phantom::sphere(16, 5.0).unwrap());
+    let tf = presets::builtin("grayscale_ramp").unwrap();
+    let mut scene = RenderScene::single(v.clone(), Appearance::new(Mode::Dvr, tf));
+    let whole = Region::volume_box(&v.grid, 0, 0);
+    let centre = (v.grid.world_bounds().0 + v.grid.world_bounds().1) * 0.5;
+    scene.regions = vec![whole.clone().clipped(Plane::through(centre, Vec3::X)), whole.clipped(Plane::through(centre, -Vec3::X))];
+    let packed = pack(&scene, 2048).unwrap();
+    assert_ne!(packed.features & features::UNIFORM_HEADERS, 0);
+    // A header holds what the loop reads of its record: the same planes, the same
+    // world step along any direction (to_native's fourth column does not act on one).
+    let mut r = packed.regions[1];
+    r.to_native.w_axis = glam::Vec4::new(5.0, -7.0, 3.0, 1.0);
+    r.bricked.x = 3;
+    r.projection.z = 2.0;
+    let h = GpuRegionHeader::of(&r);
+    assert_eq!((h.cluster, h.bounds), (r.cluster, r.bounds));
+    assert_eq!(h.planes.to_array(), [r.plane_offset, r.plane_count, r.hole_offset, r.hole_count]);
+    assert_eq!(h.kind.to_array(), [r.mode, r.flags, 3, 2]);
+    assert_eq!([h.native[0].w, h.native[1].w], [r.native_step, r.reference_length]);
+    for dir in [Vec3::X, Vec3::new(0.3, -0.8, 0.52).normalize()] {
+        let by_record = (r.to_native * dir.extend(0.0)).truncate();
+        let by_header = h.native[0].truncate() * dir.x + h.native[1].truncate() * dir.y + h.native[2].truncate() * dir.z;
+        assert!((by_record - by_header).length() <= 1e-6 * by_record.length(), "{by_record} {by_header}");
+    }
+    // The scene's uniform buffer holds them within the 64 KiB a uniform binding may
+    // hold on every device.
+    use bevy::render::render_resource::ShaderType;
+    let size = super::super::gpu_types::GpuSceneInfo::min_size().get();
+    assert!(size <= 65536 && size >= (MAX_HEADERS * 112 + MAX_HEADER_PLANES * 16) as u64, "{size}");
+    // Beyond the uniform buffer's room, the records in storage.
+    assert!(headers_fit(MAX_HEADERS as u32, MAX_HEADER_PLANES));
+    assert!(!headers_fit(MAX_HEADERS as u32 + 1, 6));
+    assert!(!headers_fit(2, MAX_HEADER_PLANES + 1));
 }
