@@ -55,7 +55,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 23] = [
+const DEFS: [&str; 24] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -79,6 +79,7 @@ const DEFS: [&str; 23] = [
     "SEVERAL_INSETS",
     "VALUE_RANGES",
     "UNIFORM_HEADERS",
+    "UNIFORM_REGIONS",
 ];
 
 #[test]
@@ -106,7 +107,9 @@ fn every_shader_variant_composes_and_validates() {
     let bricked = bit("HAS_BRICKED") | bit("BRICKED_ONLY");
     // (The region headers' source: with the interval code's defs alone, below.)
     let headers = bit("UNIFORM_HEADERS");
-    let full = ((1u32 << DEFS.len()) - 1) & !headers;
+    // (The region records' buffer: with up to two other defs and with all, below.)
+    let records = bit("UNIFORM_REGIONS");
+    let full = ((1u32 << DEFS.len()) - 1) & !headers & !records;
     let all_but_holes = full & !bricked & !bit("HAS_HOLES");
     let possible =
         |bits: u32| possible(bits) && (bits & bricked == 0 || (bits & !bricked).count_ones() <= 2 || bits & !bricked == all_but_holes);
@@ -140,6 +143,13 @@ fn every_shader_variant_composes_and_validates() {
     // The regions' headers read from the uniform buffer change the interval loop
     // alone: with the defs that share it (and bricked steps), not every other.
     let possible = |bits: u32| possible(bits & !headers) && (bits & headers == 0 || bits & !(headers | interval_defs | bricked) == 0);
+    // The region records read from a uniform buffer change where every record is read
+    // from, not the code: with up to two other defs, and with every def that can be
+    // on together.
+    let everything = (0u32..(1 << DEFS.len())).filter(|b| b & records == 0 && possible(*b)).max_by_key(|b| b.count_ones()).unwrap_or(0);
+    let possible = |bits: u32| {
+        possible(bits & !records) && (bits & records == 0 || (bits & !records).count_ones() <= 2 || bits & !records == everything)
+    };
     let variants: Vec<u32> = (0u32..(1 << DEFS.len())).filter(|b| possible(*b)).collect();
     // (On every core: the variants are independent, and one after another they were
     // six of the suite's minutes. A variant that fails panics its thread, and the scope
@@ -204,6 +214,7 @@ fn shader_constants_match_the_renderer() {
     assert_eq!(constant("MAX_INSETS") as usize, focal::render::gpu_types::MAX_INSETS);
     assert_eq!(constant("MAX_HEADERS") as usize, focal::render::gpu_types::MAX_HEADERS);
     assert_eq!(constant("MAX_HEADER_PLANES") as usize, focal::render::gpu_types::MAX_HEADER_PLANES);
+    assert_eq!(constant("MAX_UNIFORM_REGIONS") as usize, focal::render::gpu_types::MAX_UNIFORM_REGIONS);
 }
 
 #[test]

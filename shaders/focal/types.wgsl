@@ -94,6 +94,9 @@ struct SceneInfo {
     header_planes: array<vec4<f32>, MAX_HEADER_PLANES>,
 }
 
+// (render::gpu_types::MAX_UNIFORM_REGIONS)
+const MAX_UNIFORM_REGIONS: u32 = 120u;
+
 // (render::gpu_types::MAX_HEADERS, MAX_HEADER_PLANES)
 const MAX_HEADERS: u32 = 128u;
 const MAX_HEADER_PLANES: u32 = 1024u;

@@ -121,6 +121,11 @@ pub mod features {
     /// The traversed regions' headers and every plane fit the scene's uniform buffer
     /// ([`super::GpuSceneInfo::headers`]): the ray's interval loop reads them there.
     pub const UNIFORM_HEADERS: u32 = 1 << 28;
+    /// Every region record fits the uniform copy of the records
+    /// ([`super::MAX_UNIFORM_REGIONS`]): the shader reads them there (on llvmpipe a load
+    /// from a storage buffer runs lane by lane, with a branch per lane and word; a load
+    /// from a uniform buffer by a per-lane index is one gather).
+    pub const UNIFORM_REGIONS: u32 = 1 << 29;
 
     /// Shader def names of the lens kinds and shapes, by bit.
     pub const LENS_NAMES: [(u32, &str); 5] = [
@@ -132,7 +137,7 @@ pub mod features {
     ];
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 23] = [
+    pub const NAMES: [(u32, &str); 24] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -156,6 +161,7 @@ pub mod features {
         (SEVERAL_INSETS, "SEVERAL_INSETS"),
         (VALUE_RANGES, "VALUE_RANGES"),
         (UNIFORM_HEADERS, "UNIFORM_HEADERS"),
+        (UNIFORM_REGIONS, "UNIFORM_REGIONS"),
     ];
 }
 
@@ -393,6 +399,11 @@ impl GpuRegionHeader {
         }
     }
 }
+
+/// Region records in the uniform copy of the records (`MAX_UNIFORM_REGIONS` in
+/// `shaders/focal/types.wgsl`): 120 records of 544 bytes, within the 64 KiB a uniform
+/// binding may hold. The copy is always bound, this size, zeros past the scene's.
+pub const MAX_UNIFORM_REGIONS: usize = 120;
 
 /// Whether the headers of `region_count` traversed regions and `planes` planes fit the
 /// scene's uniform buffer ([`GpuSceneInfo::headers`]).

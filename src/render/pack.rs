@@ -194,6 +194,9 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
     if super::gpu_types::headers_fit(out.region_count, out.planes.len().max(1)) {
         out.features |= super::gpu_types::features::UNIFORM_HEADERS;
     }
+    if out.regions.len() <= super::gpu_types::MAX_UNIFORM_REGIONS {
+        out.features |= super::gpu_types::features::UNIFORM_REGIONS;
+    }
     // Empty scenes still bind (1-texel) atlases.
     out.atlas.size = out.atlas.size.max(UVec3::ONE);
     out.brick_atlas.size = out.brick_atlas.size.max(UVec3::ONE);

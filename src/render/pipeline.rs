@@ -3,7 +3,7 @@
 use bevy::core_pipeline::FullscreenShader;
 use bevy::prelude::*;
 use bevy::render::render_resource::binding_types::{
-    sampler, storage_buffer_read_only_sized, texture_2d, texture_3d, texture_depth_2d, uniform_buffer,
+    sampler, storage_buffer_read_only_sized, texture_2d, texture_3d, texture_depth_2d, uniform_buffer, uniform_buffer_sized,
 };
 use bevy::render::render_resource::*;
 use bevy::render::renderer::RenderDevice;
@@ -44,6 +44,8 @@ pub fn init_pipeline(mut commands: Commands, device: Res<RenderDevice>, fullscre
                 storage_buffer_read_only_sized(false, None),
                 texture_3d(float(true)),
                 storage_buffer_read_only_sized(false, None),
+                // (The region records again, where they fit: render::upload.)
+                uniform_buffer_sized(false, None),
             ),
         ),
     );

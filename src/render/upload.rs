@@ -15,7 +15,7 @@ use bevy::render::renderer::{RenderAdapter, RenderDevice, RenderQueue};
 use rayon::prelude::*;
 
 use super::extract::ExtractedScene;
-use super::gpu_types::{GpuRegionHeader, GpuSceneInfo, features};
+use super::gpu_types::{GpuRegion, GpuRegionHeader, GpuSceneInfo, MAX_UNIFORM_REGIONS, features};
 use super::pack::{LUT_ATLAS_WIDTH, MAX_INSETS, PackedScene, pack};
 use crate::region::RenderScene;
 use crate::volume::{Volume, Voxels};
@@ -36,6 +36,9 @@ pub struct GpuScene {
     pub atlases: Option<GpuAtlases>,
     pub info: Option<Buffer>,
     pub regions: Option<Buffer>,
+    /// The region records again in a uniform buffer of [`MAX_UNIFORM_REGIONS`] records
+    /// where they fit (`features::UNIFORM_REGIONS`; zeros where not: always bound).
+    pub uniform_regions: Option<Buffer>,
     pub planes: Option<Buffer>,
     pub occupancy: Option<Buffer>,
     pub lut: Option<(Texture, TextureView)>,
@@ -351,6 +354,19 @@ fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScen
     }));
     let regions = if packed.regions.is_empty() { vec![Default::default()] } else { packed.regions.clone() };
     gpu.regions = Some(storage(device, "focal regions", &regions));
+    let mut copy = vec![GpuRegion::default(); MAX_UNIFORM_REGIONS];
+    if packed.features & features::UNIFORM_REGIONS != 0 {
+        copy[..packed.regions.len()].copy_from_slice(&packed.regions);
+    }
+    // (A record's layout is the same in both address spaces: vectors and matrices, and
+    // scalars in runs that end at a 16-byte boundary; a pack test holds the size.)
+    let mut bytes = StorageBuffer::new(Vec::new());
+    let _ = bytes.write(&copy);
+    gpu.uniform_regions = Some(device.create_buffer_with_data(&BufferInitDescriptor {
+        label: Some("focal regions (uniform)"),
+        contents: bytes.as_ref(),
+        usage: BufferUsages::UNIFORM | BufferUsages::COPY_DST,
+    }));
     gpu.planes = Some(storage(device, "focal planes", &packed.planes));
     gpu.occupancy = Some(storage(device, "focal occupancy", &packed.occupancy));
     let rows = packed.lut_rows();

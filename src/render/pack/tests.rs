@@ -212,7 +212,7 @@ fn packs_regions_planes_luts_and_the_atlas() {
     assert_eq!(packed.lut.len(), LUT_ATLAS_WIDTH as usize);
     assert_eq!(packed.regions[0].dims, glam::Vec4::new(16.0, 16.0, 16.0, 255.0));
     use crate::render::gpu_types::features as f;
-    assert_eq!(packed.features, f::PROJECTION | f::SHADING | f::MULTI_REGION | f::MIP_READS | f::UNIFORM_HEADERS);
+    assert_eq!(packed.features, f::PROJECTION | f::SHADING | f::MULTI_REGION | f::MIP_READS | f::UNIFORM_HEADERS | f::UNIFORM_REGIONS);
     // Regions reading a mip chain: scalar samples of volumes in memory, not label codes,
     // not bricked volumes, not regions that draw nothing.
     let scalar = packed.regions[1];
@@ -509,6 +509,12 @@ fn the_interval_loop_reads_headers_from_the_uniform_buffer_while_they_fit() {
     use bevy::render::render_resource::ShaderType;
     let size = super::super::gpu_types::GpuSceneInfo::min_size().get();
     assert!(size <= 65536 && size >= (MAX_HEADERS * 112 + MAX_HEADER_PLANES * 16) as u64, "{size}");
+    // The region records' uniform copy: every record of this scene, within 64 KiB.
+    use super::super::gpu_types::{GpuRegion, MAX_UNIFORM_REGIONS};
+    assert_ne!(packed.features & features::UNIFORM_REGIONS, 0);
+    let record = GpuRegion::min_size().get();
+    assert_eq!(record % 16, 0, "a record ends at a 16-byte boundary: one stride in both address spaces");
+    assert!(record * MAX_UNIFORM_REGIONS as u64 <= 65536 && record * (MAX_UNIFORM_REGIONS as u64 + 1) > 65536, "{record}");
     // Beyond the uniform buffer's room, the records in storage.
     assert!(headers_fit(MAX_HEADERS as u32, MAX_HEADER_PLANES));
     assert!(!headers_fit(MAX_HEADERS as u32 + 1, 6));
