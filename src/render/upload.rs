@@ -317,13 +317,24 @@ fn storage<T: bevy::render::render_resource::ShaderType + bevy::render::render_r
     label: &str,
     value: &T,
 ) -> Buffer {
+    laid_out(device, label, value, BufferUsages::STORAGE)
+}
+
+/// A buffer of `value` in the storage layout with `usage` (a uniform one where that
+/// layout is the uniform one too: the region records).
+fn laid_out<T: bevy::render::render_resource::ShaderType + bevy::render::render_resource::encase::internal::WriteInto>(
+    device: &RenderDevice,
+    label: &str,
+    value: &T,
+    usage: BufferUsages,
+) -> Buffer {
     let mut bytes = StorageBuffer::new(Vec::new());
     // Writing into a Vec cannot fail for these plain types.
     let _ = bytes.write(value);
     device.create_buffer_with_data(&BufferInitDescriptor {
         label: Some(label),
         contents: bytes.as_ref(),
-        usage: BufferUsages::STORAGE | BufferUsages::COPY_DST,
+        usage: usage | BufferUsages::COPY_DST,
     })
 }
 
@@ -360,13 +371,7 @@ fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScen
     }
     // (A record's layout is the same in both address spaces: vectors and matrices, and
     // scalars in runs that end at a 16-byte boundary; a pack test holds the size.)
-    let mut bytes = StorageBuffer::new(Vec::new());
-    let _ = bytes.write(&copy);
-    gpu.uniform_regions = Some(device.create_buffer_with_data(&BufferInitDescriptor {
-        label: Some("focal regions (uniform)"),
-        contents: bytes.as_ref(),
-        usage: BufferUsages::UNIFORM | BufferUsages::COPY_DST,
-    }));
+    gpu.uniform_regions = Some(laid_out(device, "focal regions (uniform)", &copy, BufferUsages::UNIFORM));
     gpu.planes = Some(storage(device, "focal planes", &packed.planes));
     gpu.occupancy = Some(storage(device, "focal occupancy", &packed.occupancy));
     let rows = packed.lut_rows();
