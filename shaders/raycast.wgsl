@@ -36,8 +36,7 @@
 #import focal::bindings::{view, settings, scene, regions, depth_texture}
 #import focal::camera::{Ray, camera_ray, scene_depth_t, jitter}
 #import focal::lens::{lens_ray, lens_footprint, restrict_footprint, update_lod, level_varies}
-#import focal::regions::{meets_sphere, pick_region, to_voxel, dir_to_voxel}
-#import focal::headers::{cluster_of, bounds_of, planes_of, kind_of, step_of, planes_interval}
+#import focal::regions::{region_interval, hole_interval, meets_sphere, pick_region, to_voxel, dir_to_voxel, world_step}
 #import focal::sampling::{trilinear, brick_occupied, brick_range, at_full_resolution, count_sample, ray_sample_count, set_lod}
 #import focal::bricked::page_lookup_count
 #import focal::selection::{region_weight, set_weight, pick_weight, set_companion, no_companion}
@@ -100,15 +99,14 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
     // a run of REGION_CLUSTER regions skips the run: all of it when a whole SIMD group
     // misses.)
     for (var c = 0u; c < scene.region_count; c += REGION_CLUSTER) {
-        if !meets_sphere(cluster_of(c), ray.origin, ray.dir) {
+        if !meets_sphere(regions[c].cluster, ray.origin, ray.dir) {
             continue;
         }
         for (var i = c; i < min(c + REGION_CLUSTER, scene.region_count); i++) {
-            if !meets_sphere(bounds_of(i), ray.origin, ray.dir) {
+            if !meets_sphere(regions[i].bounds, ray.origin, ray.dir) {
                 continue;
             }
-            let pl = planes_of(i);
-            let iv = planes_interval(pl.x, pl.y, ray.origin, ray.dir);
+            let iv = region_interval(regions[i], ray.origin, ray.dir);
             let t0 = max(iv.x, 0.0);
             if t0 < iv.y && n < MAX_RAY_REGIONS {
                 // One interval, less each hole's: intervals first..n of region i.
@@ -118,11 +116,10 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                 t1s[n] = iv.y;
                 n++;
 #ifdef HAS_HOLES
-                let holes = pl.w;
+                let holes = regions[i].hole_count;
                 if holes > 0u {
-                    for (var hole = 0u; hole < holes; hole++) {
-                        let cut = planes_interval(pl.z + 6u * hole, 6u, ray.origin, ray.dir);
-                        n = cut_intervals(i, first, n, cut, &ids, &t0s, &t1s);
+                    for (var h = 0u; h < holes; h++) {
+                        n = cut_intervals(i, first, n, hole_interval(regions[i], h, ray.origin, ray.dir), &ids, &t0s, &t1s);
                     }
                     n = compact_intervals(first, n, &ids, &t0s, &t1s);
                 }
@@ -136,21 +133,21 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
                 t_end = max(t_end, iv.y);
 #endif
                 if n > first {
-                    let steps = step_of(i, ray.dir);
-                    var ws = steps.x;
-                    let factor = steps.y;
-                    let kinds = kind_of(i);
+                    var ws = world_step(regions[i], ray.dir);
+                    // (Opacity correction per world length: a finer level's shorter
+                    // steps each take less, Volume::opacity_reference.)
+                    let factor = regions[i].native_step / (ws * regions[i].reference_length);
 #ifdef HAS_BRICKED
                     // A bricked region steps at the level its footprint asks for.
-                    if kinds.z != 0u {
+                    if regions[i].bricked.x != 0u {
                         ws *= bricked_step_at(regions[i], ray.dir, t0);
                     }
 #endif
                     step = min(step, ws);
-                    let mode = kinds.x;
+                    let mode = regions[i].mode;
                     var kind = select(0u, CLOSES, is_projection(mode) || mode == MODE_TWO_LEVEL);
-                    kind |= select(0u, PAIRABLE, is_dvr_like(mode, kinds.y));
-                    let group = kinds.w;
+                    kind |= select(0u, PAIRABLE, is_dvr_like(mode, regions[i].flags));
+                    let group = u32(regions[i].projection.z);
 #ifdef HAS_HOLES
                     for (var e = first; e < n; e++) {
                         ratios[e] = factor;

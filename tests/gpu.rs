@@ -446,7 +446,7 @@ fn main() {
     println!("GPU: {}", off.adapter_name());
     off.set_view(VolumeView { jitter: false, ..Default::default() });
     let mut gpu = Gpu { off };
-    let tests: [GpuTest; 39] = [
+    let tests: [GpuTest; 40] = [
         ("each_mode_matches_the_reference", each_mode_matches_the_reference),
         ("labels_match_the_reference", labels_match_the_reference),
         ("axis_aligned_mip_is_the_voxel_maximum", axis_aligned_mip_is_the_voxel_maximum),
@@ -473,6 +473,7 @@ fn main() {
         ("kappa_t_zero_is_dvr_on_the_gpu", context::kappa_t_zero_is_dvr_on_the_gpu),
         ("clipping_matches_the_reference", clip::clipping_matches_the_reference),
         ("a_clip_box_inside_the_engine_makes_minip_useful", clip::a_clip_box_inside_the_engine_makes_minip_useful),
+        ("occupancy_beyond_its_uniform_copy_matches_the_reference", clip::occupancy_beyond_its_uniform_copy_matches_the_reference),
         ("two_level_matches_the_reference", twolevel::two_level_matches_the_reference),
         ("overlapping_two_level_regions_match_the_reference", twolevel::overlapping_two_level_regions_match_the_reference),
         ("the_rest_draws_no_rim_beside_a_hidden_object", twolevel::the_rest_draws_no_rim_beside_a_hidden_object),

@@ -17,12 +17,11 @@ struct View {
 const BEVY_FULLSCREEN: &str = "#define_import_path bevy_core_pipeline::fullscreen_vertex_shader
 struct FullscreenVertexOutput { @builtin(position) position: vec4<f32>, @location(0) uv: vec2<f32> }";
 
-const MODULES: [&str; 18] = [
+const MODULES: [&str; 17] = [
     "types",
     "bindings",
     "camera",
     "regions",
-    "headers",
     "bricked",
     "sampling",
     "lens",
@@ -55,7 +54,7 @@ fn add(composer: &mut Composer, source: &str, path: &str) {
 }
 
 /// Shader defs of the ray caster (mirrors `render::gpu_types::features::NAMES`).
-const DEFS: [&str; 24] = [
+const DEFS: [&str; 25] = [
     "HAS_DVR",
     "HAS_GRADIENT_MODULATION",
     "HAS_LABELS",
@@ -78,8 +77,9 @@ const DEFS: [&str; 24] = [
     "INSETS",
     "SEVERAL_INSETS",
     "VALUE_RANGES",
-    "UNIFORM_HEADERS",
+    "UNIFORM_PLANES",
     "UNIFORM_REGIONS",
+    "UNIFORM_OCCUPANCY",
 ];
 
 #[test]
@@ -105,11 +105,9 @@ fn every_shader_variant_composes_and_validates() {
     // them (every combination doubled the test's 3½ minutes), each with and without
     // BRICKED_ONLY.
     let bricked = bit("HAS_BRICKED") | bit("BRICKED_ONLY");
-    // (The region headers' source: with the interval code's defs alone, below.)
-    let headers = bit("UNIFORM_HEADERS");
-    // (The region records' buffer: with up to two other defs and with all, below.)
-    let records = bit("UNIFORM_REGIONS");
-    let full = ((1u32 << DEFS.len()) - 1) & !headers & !records;
+    // (The uniform copies: with up to two other defs and with all, below.)
+    let copies = bit("UNIFORM_PLANES") | bit("UNIFORM_REGIONS") | bit("UNIFORM_OCCUPANCY");
+    let full = ((1u32 << DEFS.len()) - 1) & !copies;
     let all_but_holes = full & !bricked & !bit("HAS_HOLES");
     let possible =
         |bits: u32| possible(bits) && (bits & bricked == 0 || (bits & !bricked).count_ones() <= 2 || bits & !bricked == all_but_holes);
@@ -140,15 +138,13 @@ fn every_shader_variant_composes_and_validates() {
                 || (bits & bit("HAS_TWO_LEVEL") != 0
                     && ((bits & !ranges).count_ones() <= 3 || (bits | bricked | bit("HAS_HOLES") | insets) == full)))
     };
-    // The regions' headers read from the uniform buffer change the interval loop
-    // alone: with the defs that share it (and bricked steps), not every other.
-    let possible = |bits: u32| possible(bits & !headers) && (bits & headers == 0 || bits & !(headers | interval_defs | bricked) == 0);
-    // The region records read from a uniform buffer change where every record is read
-    // from, not the code: with up to two other defs, and with every def that can be
-    // on together.
-    let everything = (0u32..(1 << DEFS.len())).filter(|b| b & records == 0 && possible(*b)).max_by_key(|b| b.count_ones()).unwrap_or(0);
+    // The uniform copies of the records, the planes and the occupancy bits change
+    // where each is read from, not the code: all three with up to two other defs, and
+    // each set of them with every def that can be on together.
+    let everything = (0u32..(1 << DEFS.len())).filter(|b| b & copies == 0 && possible(*b)).max_by_key(|b| b.count_ones()).unwrap_or(0);
     let possible = |bits: u32| {
-        possible(bits & !records) && (bits & records == 0 || (bits & !records).count_ones() <= 2 || bits & !records == everything)
+        possible(bits & !copies)
+            && (bits & copies == 0 || (bits & copies == copies && (bits & !copies).count_ones() <= 2) || bits & !copies == everything)
     };
     let variants: Vec<u32> = (0u32..(1 << DEFS.len())).filter(|b| possible(*b)).collect();
     // (On every core: the variants are independent, and one after another they were
@@ -212,9 +208,9 @@ fn shader_constants_match_the_renderer() {
     };
     assert_eq!(constant("LUT_ATLAS_WIDTH"), focal::render::pack::LUT_ATLAS_WIDTH);
     assert_eq!(constant("MAX_INSETS") as usize, focal::render::gpu_types::MAX_INSETS);
-    assert_eq!(constant("MAX_HEADERS") as usize, focal::render::gpu_types::MAX_HEADERS);
-    assert_eq!(constant("MAX_HEADER_PLANES") as usize, focal::render::gpu_types::MAX_HEADER_PLANES);
     assert_eq!(constant("MAX_UNIFORM_REGIONS") as usize, focal::render::gpu_types::MAX_UNIFORM_REGIONS);
+    assert_eq!(constant("MAX_UNIFORM_PLANES") as usize, focal::render::gpu_types::MAX_UNIFORM_PLANES);
+    assert_eq!(constant("MAX_UNIFORM_OCCUPANCY") as usize, focal::render::gpu_types::MAX_UNIFORM_OCCUPANCY);
 }
 
 #[test]

@@ -1,7 +1,7 @@
 #define_import_path focal::regions
 
-// Convex regions: ray intervals, the world→voxel map
-// (reference: region::ray_convex; the interval loop's own reads: focal::headers).
+// Convex regions: ray intervals, the world→voxel map, step lengths
+// (reference: region::ray_convex, PreparedRegion::world_step).
 
 #import focal::types::Region
 #import focal::bindings::planes
@@ -9,6 +9,11 @@
 // [t0, t1] of the ray inside the region's planes; t0 > t1 when it misses.
 fn region_interval(r: Region, origin: vec3<f32>, dir: vec3<f32>) -> vec2<f32> {
     return convex_interval(r.plane_offset, r.plane_count, origin, dir);
+}
+
+// [t0, t1] of the ray inside hole h of the region (a box); t0 > t1 when it misses.
+fn hole_interval(r: Region, h: u32, origin: vec3<f32>, dir: vec3<f32>) -> vec2<f32> {
+    return convex_interval(r.hole_offset + 6u * h, 6u, origin, dir);
 }
 
 // Whether world point p lies inside one of the region's holes (off its boundary).
@@ -62,6 +67,11 @@ fn to_voxel(r: Region, p: vec3<f32>) -> vec3<f32> {
 
 fn dir_to_voxel(r: Region, d: vec3<f32>) -> vec3<f32> {
     return (r.world_to_voxel * vec4(d, 0.0)).xyz;
+}
+
+// World step that advances the region's native step in its volume along `dir`.
+fn world_step(r: Region, dir: vec3<f32>) -> f32 {
+    return r.native_step / max(length((r.to_native * vec4(dir, 0.0)).xyz), 1e-9);
 }
 
 fn pick_region(a: Region, b: Region, second: bool) -> Region {

@@ -6,7 +6,7 @@
 // and min-max (reference: volume::sample, volume::bricks).
 
 #import focal::types::{Region, REGION_LABELS, LUT_ATLAS_WIDTH}
-#import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy, lut_atlas, brick_cache}
+#import focal::bindings::{scene, volume_atlas, brick_atlas, volume_sampler, occupancy_word, lut_atlas, brick_cache}
 #import focal::bricked::{is_bricked, level_zero, bricked_locate, bricked_texel, bricked_uvw, bricked_box_exit, box_exit, bricked_step_factor, sub_block_visible, sub_block_exit, bricked_gradient, bricked_gradient_max, bc_kind, bc_code, BRICKED_TEXEL, BRICKED_EMPTY}
 
 // The ray's samples taken (sample positions marched, not fetches) and page look-ups of
@@ -301,7 +301,7 @@ fn brick_occupied(r: Region, q: vec3<f32>) -> bool {
     let i = (b.z * r.bricks.y + b.y) * r.bricks.x + b.x;
     let words = (r.bricks.x * r.bricks.y * r.bricks.z + 31u) / 32u;
     let bits = select(0u, 1u, sample_lod > 0.0) + select(0u, 1u, sample_lod > 1.0);
-    let word = occupancy[r.occupancy_offset + bits * words + i / 32u];
+    let word = occupancy_word(r.occupancy_offset + bits * words + i / 32u);
     return ((word >> (i % 32u)) & 1u) != 0u;
 #endif
 }

@@ -10,7 +10,7 @@
 // made a weighted sample cost twice an unweighted one.
 
 #import focal::types::{Region, REGION_SELECTION, REGION_KEEP_UNSELECTED, REGION_COMPANION}
-#import focal::bindings::{regions, occupancy}
+#import focal::bindings::{regions, occupancy_word}
 #import focal::sampling::trilinear_box
 #import focal::regions::region_interval
 
@@ -123,7 +123,7 @@ fn weight_at(q: vec3<f32>, carried: f32) -> f32 {
     let size = f32(weight.bricks.w);
     let b = min(vec3<u32>(max(floor((qs + 0.5) / size), vec3(0.0))), weight.bricks.xyz - 1u);
     let i = (b.z * weight.bricks.y + b.y) * weight.bricks.x + b.x;
-    let kind = (occupancy[weight.kinds + i / 16u] >> (2u * (i % 16u))) & 3u;
+    let kind = (occupancy_word(weight.kinds + i / 16u) >> (2u * (i % 16u))) & 3u;
     var t = f32(kind);
     if kind == 2u {
         t = trilinear_box(weight.offset.xyz, weight.dims.xyz, qs);

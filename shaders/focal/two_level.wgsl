@@ -5,7 +5,7 @@
 // gathered, and one sample of it by its part's mode.
 
 #import focal::types::{Region, MODE_ISO, MODE_OFF, REGION_ON_GRID, REGION_OCCUPANCY}
-#import focal::bindings::{scene, regions, occupancy}
+#import focal::bindings::{scene, regions, occupancy_word}
 #import focal::camera::Ray
 #import focal::regions::to_voxel
 #import focal::sampling::{lut_texel, trilinear, trilinear_box, nearest_code, count_sample, at_full_resolution, brick_of}
@@ -87,7 +87,7 @@ fn boundary_brick(labels: Region, q: vec3<f32>) -> bool {
     }
     let b = brick_of(labels, q);
     let i = (b.z * labels.bricks.y + b.y) * labels.bricks.x + b.x;
-    return ((occupancy[labels.occupancy_offset + i / 32u] >> (i % 32u)) & 1u) != 0u;
+    return ((occupancy_word(labels.occupancy_offset + i / 32u) >> (i % 32u)) & 1u) != 0u;
 }
 
 // The value of a sample of segmented region r at data voxel q (plain trilinear value v)

@@ -88,30 +88,14 @@ struct SceneInfo {
     // (focal::insets).
     inset_count: u32,
     insets: array<Inset, MAX_INSETS>,
-    // With UNIFORM_HEADERS: what the interval loop reads of each traversed region, and
-    // every plane of the scene (focal::headers).
-    headers: array<RegionHeader, MAX_HEADERS>,
-    header_planes: array<vec4<f32>, MAX_HEADER_PLANES>,
 }
 
-// (render::gpu_types::MAX_UNIFORM_REGIONS)
+// The uniform copies' sizes (render::gpu_types::MAX_UNIFORM_REGIONS, MAX_UNIFORM_PLANES,
+// MAX_UNIFORM_OCCUPANCY: words, read four to a vec4 as a uniform array's stride is 16
+// bytes; focal::bindings).
 const MAX_UNIFORM_REGIONS: u32 = 120u;
-
-// (render::gpu_types::MAX_HEADERS, MAX_HEADER_PLANES)
-const MAX_HEADERS: u32 = 128u;
-const MAX_HEADER_PLANES: u32 = 1024u;
-
-// What the ray's interval loop reads of a traversed region (render::gpu_types::
-// GpuRegionHeader, focal::headers): cluster and bounds spheres; to_native's first three
-// columns (xyz) with native_step and reference_length (w); plane_offset, plane_count,
-// hole_offset, hole_count; mode, flags, bricked.x, projection group.
-struct RegionHeader {
-    cluster: vec4<f32>,
-    bounds: vec4<f32>,
-    native: array<vec4<f32>, 3>,
-    planes: vec4<u32>,
-    kind: vec4<u32>,
-}
+const MAX_UNIFORM_PLANES: u32 = 4096u;
+const MAX_UNIFORM_OCCUPANCY: u32 = 16384u;
 
 // (render::gpu_types::MAX_INSETS)
 const MAX_INSETS: u32 = 4u;

@@ -118,14 +118,17 @@ pub mod features {
     /// is the first of its label's candidates whose range holds its value (without, the
     /// first candidate: no object's range is read).
     pub const VALUE_RANGES: u32 = 1 << 27;
-    /// The traversed regions' headers and every plane fit the scene's uniform buffer
-    /// ([`super::GpuSceneInfo::headers`]): the ray's interval loop reads them there.
-    pub const UNIFORM_HEADERS: u32 = 1 << 28;
+    /// Every plane fits the uniform copy of the planes ([`super::MAX_UNIFORM_PLANES`]):
+    /// the shader reads them there (`render::upload::UniformCopies`).
+    pub const UNIFORM_PLANES: u32 = 1 << 28;
     /// Every region record fits the uniform copy of the records
     /// ([`super::MAX_UNIFORM_REGIONS`]): the shader reads them there (on llvmpipe a load
     /// from a storage buffer runs lane by lane, with a branch per lane and word; a load
     /// from a uniform buffer by a per-lane index is one gather).
     pub const UNIFORM_REGIONS: u32 = 1 << 29;
+    /// Every occupancy word fits the uniform copy of the occupancy bits
+    /// ([`super::MAX_UNIFORM_OCCUPANCY`]): the empty-space tests read them there.
+    pub const UNIFORM_OCCUPANCY: u32 = 1 << 30;
 
     /// Shader def names of the lens kinds and shapes, by bit.
     pub const LENS_NAMES: [(u32, &str); 5] = [
@@ -137,7 +140,7 @@ pub mod features {
     ];
 
     /// Shader def names, by bit.
-    pub const NAMES: [(u32, &str); 24] = [
+    pub const NAMES: [(u32, &str); 25] = [
         (DVR, "HAS_DVR"),
         (GRADIENT_MODULATION, "HAS_GRADIENT_MODULATION"),
         (LABELS, "HAS_LABELS"),
@@ -160,8 +163,9 @@ pub mod features {
         (INSETS, "INSETS"),
         (SEVERAL_INSETS, "SEVERAL_INSETS"),
         (VALUE_RANGES, "VALUE_RANGES"),
-        (UNIFORM_HEADERS, "UNIFORM_HEADERS"),
+        (UNIFORM_PLANES, "UNIFORM_PLANES"),
         (UNIFORM_REGIONS, "UNIFORM_REGIONS"),
+        (UNIFORM_OCCUPANCY, "UNIFORM_OCCUPANCY"),
     ];
 }
 
@@ -320,7 +324,7 @@ impl Default for GpuSettings {
 }
 
 /// Per-scene facts.
-#[derive(Clone, Copy, Debug, PartialEq, ShaderType)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
 pub struct GpuSceneInfo {
     /// 1 / size of the volume atlas in texels (xyz).
     pub inv_atlas_size: Vec4,
@@ -336,68 +340,6 @@ pub struct GpuSceneInfo {
     /// of a storage buffer at an address taken from another record loaded lane by lane,
     /// and six planes a window so read cost 5 % of a frame).
     pub insets: [GpuInset; MAX_INSETS],
-    /// With [`features::UNIFORM_HEADERS`]: what the ray's interval loop reads of each
-    /// traversed region ([`GpuRegionHeader::of`]), and every plane of the scene (the
-    /// regions' `plane_offset` and `hole_offset` index it as they index the storage
-    /// buffer's). The loop visits the regions in the same order in every lane, yet on
-    /// llvmpipe each field it read from the storage buffer cost a gather of eight lanes;
-    /// from a uniform buffer it is one load.
-    pub headers: [GpuRegionHeader; MAX_HEADERS],
-    pub header_planes: [Vec4; MAX_HEADER_PLANES],
-}
-
-impl Default for GpuSceneInfo {
-    fn default() -> Self {
-        GpuSceneInfo {
-            inv_atlas_size: Vec4::ZERO,
-            region_count: 0,
-            pad_a: 0,
-            max_steps: 0,
-            inset_count: 0,
-            insets: [GpuInset::default(); MAX_INSETS],
-            headers: [GpuRegionHeader::default(); MAX_HEADERS],
-            header_planes: [Vec4::ZERO; MAX_HEADER_PLANES],
-        }
-    }
-}
-
-/// Most traversed regions whose headers ride in the scene's uniform buffer
-/// (`MAX_HEADERS` in `shaders/focal/types.wgsl`; 112 bytes each).
-pub const MAX_HEADERS: usize = 128;
-/// Most planes (regions' and holes') of a scene whose headers ride in its uniform
-/// buffer (16 bytes each: with the headers about 31 KiB, under the 64 KiB a uniform
-/// binding may hold).
-pub const MAX_HEADER_PLANES: usize = 1024;
-
-/// What the ray's interval loop reads of a traversed region, in the scene's uniform
-/// buffer (`RegionHeader` in `shaders/focal/types.wgsl`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
-pub struct GpuRegionHeader {
-    /// [`GpuRegion::cluster`].
-    pub cluster: Vec4,
-    /// [`GpuRegion::bounds`].
-    pub bounds: Vec4,
-    /// The first three columns of [`GpuRegion::to_native`] (xyz; its fourth column
-    /// does not act on directions), with `native_step` and `reference_length` in the
-    /// first two's w.
-    pub native: [Vec4; 3],
-    /// `plane_offset`, `plane_count`, `hole_offset`, `hole_count`.
-    pub planes: UVec4,
-    /// `mode`, `flags`, `bricked.x`, the projection group (`projection.z` as an integer).
-    pub kind: UVec4,
-}
-
-impl GpuRegionHeader {
-    pub fn of(r: &GpuRegion) -> Self {
-        let w = [r.native_step, r.reference_length, 0.0];
-        GpuRegionHeader {
-            cluster: r.cluster,
-            bounds: r.bounds,
-            native: std::array::from_fn(|c| r.to_native.col(c).truncate().extend(w[c])),
-            planes: UVec4::new(r.plane_offset, r.plane_count, r.hole_offset, r.hole_count),
-            kind: UVec4::new(r.mode, r.flags, r.bricked.x, r.projection.z as u32),
-        }
-    }
 }
 
 /// Region records in the uniform copy of the records (`MAX_UNIFORM_REGIONS` in
@@ -405,11 +347,14 @@ impl GpuRegionHeader {
 /// binding may hold. The copy is always bound, this size, zeros past the scene's.
 pub const MAX_UNIFORM_REGIONS: usize = 120;
 
-/// Whether the headers of `region_count` traversed regions and `planes` planes fit the
-/// scene's uniform buffer ([`GpuSceneInfo::headers`]).
-pub fn headers_fit(region_count: u32, planes: usize) -> bool {
-    region_count as usize <= MAX_HEADERS && planes <= MAX_HEADER_PLANES
-}
+/// Planes in the uniform copy of the planes (`MAX_UNIFORM_PLANES` in
+/// `shaders/focal/types.wgsl`): 16 bytes each, 64 KiB.
+pub const MAX_UNIFORM_PLANES: usize = 4096;
+
+/// Occupancy words in the uniform copy of the occupancy bits (`MAX_UNIFORM_OCCUPANCY` in
+/// `shaders/focal/types.wgsl`, which counts them in fours: a uniform array's stride is
+/// 16 bytes): 64 KiB.
+pub const MAX_UNIFORM_OCCUPANCY: usize = 16384;
 
 /// Most clip windows a scene draws in place (`render::pack::insets`; `MAX_INSETS` in
 /// `shaders/focal/types.wgsl`).

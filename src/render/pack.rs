@@ -191,12 +191,7 @@ pub fn pack(scene: &RenderScene, max_texture: u32) -> Result<PackedScene, String
         out.features |= super::gpu_types::features::DOI_CHANNEL;
     }
     out.max_steps = march_bound(&out.regions[..out.region_count as usize], union_extent(&prepared));
-    if super::gpu_types::headers_fit(out.region_count, out.planes.len().max(1)) {
-        out.features |= super::gpu_types::features::UNIFORM_HEADERS;
-    }
-    if out.regions.len() <= super::gpu_types::MAX_UNIFORM_REGIONS {
-        out.features |= super::gpu_types::features::UNIFORM_REGIONS;
-    }
+    out.features |= uniform_copies(&out);
     // Empty scenes still bind (1-texel) atlases.
     out.atlas.size = out.atlas.size.max(UVec3::ONE);
     out.brick_atlas.size = out.brick_atlas.size.max(UVec3::ONE);
@@ -263,6 +258,18 @@ fn pack_objects(p: &PreparedRegion, slots: &[usize], out: &mut PackedScene) -> U
         ..Default::default()
     });
     UVec4::new(first, objects.parts.len() as u32, out.regions.len() as u32 - 1, 0)
+}
+
+/// Where `words` (a region's occupancy bits) lie in the scene's occupancy array: at an
+/// earlier record's run of the same words (regions of one volume under one look, as an
+/// exploded view's parts, share one run: 64 parts of a 128³ volume would need 24 576
+/// words, more than their uniform copy holds), else appended.
+fn place_occupancy(out: &mut PackedScene, words: &[u32]) -> u32 {
+    let earlier = out.regions.iter().map(|r| r.occupancy_offset as usize).find(|&o| out.occupancy.get(o..o + words.len()) == Some(words));
+    earlier.unwrap_or_else(|| {
+        out.occupancy.extend_from_slice(words);
+        out.occupancy.len() - words.len()
+    }) as u32
 }
 
 /// One bit per brick, 32 a word.
@@ -453,7 +460,7 @@ fn pack_region(p: &PreparedRegion, holes: &[[Plane; 6]], levels: &[UVec3], brick
     if p.shading.enabled {
         flags |= region_flags::SHADING;
     }
-    let occupancy_offset = out.occupancy.len() as u32;
+    let mut occupancy_offset = out.occupancy.len() as u32;
     let grid = p.volume.bricks();
     let bricks = grid.dims.extend(grid.size);
     if let Some((_, occ)) = &p.occupancy {
@@ -461,13 +468,14 @@ fn pack_region(p: &PreparedRegion, holes: &[[Plane; 6]], levels: &[UVec3], brick
         // The bits of full-resolution samples, then those of mip samples up to level 1
         // and of coarser ones (every brick where they are unknown; sampling.wgsl
         // brick_occupied).
-        out.occupancy.extend(occupancy_words(occ.iter().copied()));
+        let mut words = occupancy_words(occ.iter().copied());
         for k in 0..2 {
             match p.mip_occupancy.as_ref().map(|m| &m[k]).filter(|m| m.len() == occ.len()) {
-                Some(m) => out.occupancy.extend(occupancy_words(m.iter().copied())),
-                None => out.occupancy.extend(occupancy_words(occ.iter().map(|_| true))),
+                Some(m) => words.extend(occupancy_words(m.iter().copied())),
+                None => words.extend(occupancy_words(occ.iter().map(|_| true))),
             }
         }
+        occupancy_offset = place_occupancy(out, &words);
     }
     let s = &p.shading;
     GpuRegion {
@@ -564,5 +572,20 @@ pub use packed::{Atlas, LUT_ATLAS_WIDTH, PackedScene, atlas_layout, gpu_plane, t
 pub use selection::{companions, constant_bricks, doi_channels, pair_table, unorm_pair};
 use selection::{draw_in, pack_selection};
 
+/// The buffers whose whole content fits their uniform copy (`render::upload::
+/// UniformCopies`): the shader reads those there. On llvmpipe a storage buffer is read
+/// lane by lane, with a branch per lane and word, even where every lane reads one
+/// address; a uniform buffer in one load, or one gather.
+fn uniform_copies(out: &PackedScene) -> u32 {
+    use super::gpu_types::{MAX_UNIFORM_OCCUPANCY, MAX_UNIFORM_PLANES, MAX_UNIFORM_REGIONS, features};
+    [
+        (out.regions.len() <= MAX_UNIFORM_REGIONS, features::UNIFORM_REGIONS),
+        (out.planes.len() <= MAX_UNIFORM_PLANES, features::UNIFORM_PLANES),
+        (out.occupancy.len() <= MAX_UNIFORM_OCCUPANCY, features::UNIFORM_OCCUPANCY),
+    ]
+    .into_iter()
+    .filter(|(fits, _)| *fits)
+    .fold(0, |acc, (_, feature)| acc | feature)
+}
 #[cfg(test)]
 mod tests;

@@ -50,8 +50,8 @@ pub fn raycast_pass(
     else {
         return;
     };
-    let (Some(info), Some(regions), Some(planes), Some(occupancy), Some((_, lut)), Some(atlases), Some(uniform_regions)) =
-        (&scene.info, &scene.regions, &scene.planes, &scene.occupancy, &scene.lut, &scene.atlases, &scene.uniform_regions)
+    let (Some(info), Some(regions), Some(planes), Some(occupancy), Some((_, lut)), Some(atlases), Some(uniform)) =
+        (&scene.info, &scene.regions, &scene.planes, &scene.occupancy, &scene.lut, &scene.atlases, &scene.uniform)
     else {
         return;
     };
@@ -79,7 +79,9 @@ pub fn raycast_pass(
             fields.fields.as_entire_binding(),
             brick_view,
             pages.as_entire_binding(),
-            uniform_regions.as_entire_binding(),
+            uniform.regions.as_entire_binding(),
+            uniform.planes.as_entire_binding(),
+            uniform.occupancy.as_entire_binding(),
         )),
     );
     // A view drawn at a reduced resolution: the rays into its smaller texture (cleared,

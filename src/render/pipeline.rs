@@ -44,7 +44,10 @@ pub fn init_pipeline(mut commands: Commands, device: Res<RenderDevice>, fullscre
                 storage_buffer_read_only_sized(false, None),
                 texture_3d(float(true)),
                 storage_buffer_read_only_sized(false, None),
-                // (The region records again, where they fit: render::upload.)
+                // (The region records, the planes and the occupancy bits again, where
+                // they fit: render::upload::UniformCopies.)
+                uniform_buffer_sized(false, None),
+                uniform_buffer_sized(false, None),
                 uniform_buffer_sized(false, None),
             ),
         ),

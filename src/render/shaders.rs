@@ -16,7 +16,7 @@ pub const FEATURE: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b
 pub const UPSCALE: Handle<Shader> = uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a13");
 
 /// (fixed handle, file name, source) of every shader.
-const SHADERS: [(Handle<Shader>, &str, &str); 21] = [
+const SHADERS: [(Handle<Shader>, &str, &str); 20] = [
     (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a01"), "shaders/focal/types.wgsl", include_str!("../../shaders/focal/types.wgsl")),
     (
         uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a02"),
@@ -66,7 +66,6 @@ const SHADERS: [(Handle<Shader>, &str, &str); 21] = [
         include_str!("../../shaders/focal/footprint.wgsl"),
     ),
     (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a14"), "shaders/focal/insets.wgsl", include_str!("../../shaders/focal/insets.wgsl")),
-    (uuid_handle!("6a1f3a52-1b0e-4c5f-9d3e-2f6c0b8e7a15"), "shaders/focal/headers.wgsl", include_str!("../../shaders/focal/headers.wgsl")),
     (RAYCAST, "shaders/raycast.wgsl", include_str!("../../shaders/raycast.wgsl")),
     (FEATURE, "shaders/feature.wgsl", include_str!("../../shaders/feature.wgsl")),
     (UPSCALE, "shaders/upscale.wgsl", include_str!("../../shaders/upscale.wgsl")),

@@ -15,7 +15,7 @@ use bevy::render::renderer::{RenderAdapter, RenderDevice, RenderQueue};
 use rayon::prelude::*;
 
 use super::extract::ExtractedScene;
-use super::gpu_types::{GpuRegion, GpuRegionHeader, GpuSceneInfo, MAX_UNIFORM_REGIONS, features};
+use super::gpu_types::{GpuSceneInfo, MAX_UNIFORM_OCCUPANCY, MAX_UNIFORM_PLANES, MAX_UNIFORM_REGIONS, features};
 use super::pack::{LUT_ATLAS_WIDTH, MAX_INSETS, PackedScene, pack};
 use crate::region::RenderScene;
 use crate::volume::{Volume, Voxels};
@@ -36,9 +36,8 @@ pub struct GpuScene {
     pub atlases: Option<GpuAtlases>,
     pub info: Option<Buffer>,
     pub regions: Option<Buffer>,
-    /// The region records again in a uniform buffer of [`MAX_UNIFORM_REGIONS`] records
-    /// where they fit (`features::UNIFORM_REGIONS`; zeros where not: always bound).
-    pub uniform_regions: Option<Buffer>,
+    /// The records, planes and occupancy bits again in uniform buffers where they fit.
+    pub uniform: Option<UniformCopies>,
     pub planes: Option<Buffer>,
     pub occupancy: Option<Buffer>,
     pub lut: Option<(Texture, TextureView)>,
@@ -63,6 +62,51 @@ impl GpuScene {
     pub fn ready(&self) -> bool {
         self.info.is_some() && self.regions.is_some() && self.lut.is_some() && self.atlases.is_some()
     }
+}
+
+/// The region records, the planes and the occupancy bits again, each in a uniform buffer
+/// of a fixed size ([`MAX_UNIFORM_REGIONS`] records, [`MAX_UNIFORM_PLANES`] planes,
+/// [`MAX_UNIFORM_OCCUPANCY`] words: 64 KiB, what a uniform binding may hold on every
+/// device), which the shader reads in place of the storage buffer where the whole
+/// content fits (`features::UNIFORM_REGIONS`, `UNIFORM_PLANES`, `UNIFORM_OCCUPANCY`:
+/// `render::pack::uniform_copies`); zeros where it does not, as every copy is bound.
+/// (Each type's layout is the same in both address spaces: a record's scalars run in
+/// groups that end at 16-byte boundaries, a pack test holds its size; planes are
+/// vectors; the occupancy words are read four to a `vec4<u32>`.)
+pub struct UniformCopies {
+    pub regions: Buffer,
+    pub planes: Buffer,
+    pub occupancy: Buffer,
+}
+
+impl UniformCopies {
+    fn of(device: &RenderDevice, packed: &PackedScene) -> Self {
+        let has = |feature: u32| packed.features & feature != 0;
+        UniformCopies {
+            regions: uniform_copy(device, "focal regions (uniform)", &packed.regions, MAX_UNIFORM_REGIONS, has(features::UNIFORM_REGIONS)),
+            planes: uniform_copy(device, "focal planes (uniform)", &packed.planes, MAX_UNIFORM_PLANES, has(features::UNIFORM_PLANES)),
+            occupancy: uniform_copy(
+                device,
+                "focal occupancy (uniform)",
+                &packed.occupancy,
+                MAX_UNIFORM_OCCUPANCY,
+                has(features::UNIFORM_OCCUPANCY),
+            ),
+        }
+    }
+}
+
+/// A uniform buffer of `capacity` items, `items` first where `fits`, zeros after.
+fn uniform_copy<T>(device: &RenderDevice, label: &str, items: &[T], capacity: usize, fits: bool) -> Buffer
+where
+    T: Copy + Default,
+    Vec<T>: bevy::render::render_resource::ShaderType + bevy::render::render_resource::encase::internal::WriteInto,
+{
+    let mut copy = vec![T::default(); capacity];
+    if fits && items.len() <= capacity {
+        copy[..items.len()].copy_from_slice(items);
+    }
+    laid_out(device, label, &copy, BufferUsages::UNIFORM)
 }
 
 /// Whether two scenes draw the same thing (volumes compared by identity).
@@ -321,7 +365,7 @@ fn storage<T: bevy::render::render_resource::ShaderType + bevy::render::render_r
 }
 
 /// A buffer of `value` in the storage layout with `usage` (a uniform one where that
-/// layout is the uniform one too: the region records).
+/// layout is the uniform one too: [`UniformCopies`]).
 fn laid_out<T: bevy::render::render_resource::ShaderType + bevy::render::render_resource::encase::internal::WriteInto>(
     device: &RenderDevice,
     label: &str,
@@ -340,7 +384,7 @@ fn laid_out<T: bevy::render::render_resource::ShaderType + bevy::render::render_
 
 fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScene, gpu: &mut GpuScene) {
     let inv = 1.0 / packed.atlas.size.max(UVec3::ONE).as_vec3();
-    let mut info = GpuSceneInfo {
+    let info = GpuSceneInfo {
         inv_atlas_size: inv.extend(0.0),
         region_count: packed.region_count,
         max_steps: packed.max_steps,
@@ -348,14 +392,6 @@ fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScen
         insets: std::array::from_fn(|i| packed.insets.get(i).copied().unwrap_or_default()),
         ..Default::default()
     };
-    if packed.features & features::UNIFORM_HEADERS != 0 {
-        for (h, r) in info.headers.iter_mut().zip(&packed.regions[..packed.region_count as usize]) {
-            *h = GpuRegionHeader::of(r);
-        }
-        for (to, from) in info.header_planes.iter_mut().zip(&packed.planes) {
-            *to = *from;
-        }
-    }
     let mut ub = UniformBuffer::new(Vec::new());
     let _ = ub.write(&info);
     gpu.info = Some(device.create_buffer_with_data(&BufferInitDescriptor {
@@ -365,13 +401,7 @@ fn write_buffers(device: &RenderDevice, queue: &RenderQueue, packed: &PackedScen
     }));
     let regions = if packed.regions.is_empty() { vec![Default::default()] } else { packed.regions.clone() };
     gpu.regions = Some(storage(device, "focal regions", &regions));
-    let mut copy = vec![GpuRegion::default(); MAX_UNIFORM_REGIONS];
-    if packed.features & features::UNIFORM_REGIONS != 0 {
-        copy[..packed.regions.len()].copy_from_slice(&packed.regions);
-    }
-    // (A record's layout is the same in both address spaces: vectors and matrices, and
-    // scalars in runs that end at a 16-byte boundary; a pack test holds the size.)
-    gpu.uniform_regions = Some(laid_out(device, "focal regions (uniform)", &copy, BufferUsages::UNIFORM));
+    gpu.uniform = Some(UniformCopies::of(device, packed));
     gpu.planes = Some(storage(device, "focal planes", &packed.planes));
     gpu.occupancy = Some(storage(device, "focal occupancy", &packed.occupancy));
     let rows = packed.lut_rows();

@@ -48,3 +48,39 @@ pub fn a_clip_box_inside_the_engine_makes_minip_useful(gpu: &mut Gpu) {
     println!("    MinIP pixels above 30: whole box {}, clip box {}", bright(&black), bright(&boxed));
     assert!(bright(&boxed) > 20 * (bright(&black) + 1), "the clip box did not lift MinIP off the air");
 }
+
+/// Seven looks of one 256³ head, each in a slab of its own (seven clipped datasets):
+/// their occupancy bits (three sets of a bit per brick, a run per distinct look) are
+/// more than their uniform copy holds (`render::gpu_types::MAX_UNIFORM_OCCUPANCY`), so
+/// the empty-space tests read them from storage; the picture is the reference's.
+pub fn occupancy_beyond_its_uniform_copy_matches_the_reference(gpu: &mut Gpu) {
+    use focal::render::gpu_types::features::UNIFORM_OCCUPANCY;
+    gpu.clear();
+    let head = Arc::new(Phantom::Head.generate(256).unwrap());
+    let (lo, hi) = head.grid.world_bounds();
+    let looks = ["ct_skin_bone", "ct_bone", "ct_vessels", "ct_soft_tissue", "grayscale_ramp", "industrial_ct", "mr_default"];
+    let mut scene = RenderScene { volumes: vec![head.clone()], ..Default::default() };
+    for (i, name) in looks.iter().enumerate() {
+        let a = Appearance::new(Mode::Dvr, presets::builtin(name).unwrap());
+        let slab = |k: usize| lo.x + (hi.x - lo.x) * k as f32 / looks.len() as f32;
+        let clip = Clipping {
+            planes: vec![],
+            clip_box: Some(ClipBox { min: Vec3::new(slab(i), lo.y, lo.z), max: Vec3::new(slab(i + 1), hi.y, hi.z), enabled: true }),
+        };
+        let mut dataset = Dataset::new(head.clone(), a.clone());
+        dataset.clip = clip.clone();
+        gpu.off.world_mut().spawn((dataset, Transform::default()));
+        let mut region = clip.region(&head.grid, Transform::default().compute_affine(), 0);
+        region.appearance = i;
+        scene.regions.push(region);
+        scene.appearances.push(a);
+    }
+    let cam = framed(&head, View::Anterior, false);
+    gpu.off.set_camera(&cam);
+    let img = gpu.off.capture().unwrap();
+    let packed = focal::render::pack::pack(&scene, 2048).unwrap();
+    assert_eq!(packed.features & UNIFORM_OCCUPANCY, 0, "{} occupancy words fit their uniform copy", packed.occupancy.len());
+    let reference = render(&scene, &cam, SIZE, SIZE).unwrap().to_image().unwrap();
+    assert_matches("seven_looks_in_slabs", &img, &reference);
+    gpu.clear();
+}

@@ -7,7 +7,7 @@ use focal::dataset::SceneRegions;
 use focal::explode::systems::{spawn_part, volume_polyhedron};
 use focal::explode::{Exploded, Part, step};
 use focal::region::Plane;
-use focal::render::gpu_types::features::UNIFORM_HEADERS;
+use focal::render::gpu_types::features::UNIFORM_REGIONS;
 use focal::volume::SelectionVolume;
 
 /// The selection on the data's grid: its degree of interest rides in the second channel
@@ -169,7 +169,7 @@ pub fn eighteen_exploded_parts_match_the_reference(gpu: &mut Gpu) {
     gpu.off.capture().unwrap();
     push_apart(gpu, data);
     matches_its_reference(gpu, "eighteen_parts_apart", &cam, 19);
-    assert_ne!(packed_features(gpu) & UNIFORM_HEADERS, 0, "the regions' headers in the uniform buffer");
+    assert_ne!(packed_features(gpu) & UNIFORM_REGIONS, 0, "the region records in their uniform copy");
     gpu.clear();
 }
 
@@ -178,16 +178,16 @@ fn packed_features(gpu: &mut Gpu) -> u32 {
     focal::render::pack::pack(&scene, 2048).unwrap().features
 }
 
-/// 150 parts (a 6×5×5 grid) exploded: more traversed regions than the scene's uniform
-/// buffer holds headers for (`render::gpu_types::MAX_HEADERS`), so the interval loop
-/// reads them from the region records in storage; every part is drawn where the
+/// 150 parts (a 6×5×5 grid) exploded: more region records than their uniform copy holds
+/// (`render::gpu_types::MAX_UNIFORM_REGIONS`), so the shader reads them from storage
+/// (the planes and the occupancy bits still from theirs); every part is drawn where the
 /// reference draws it.
 pub fn a_hundred_and_fifty_exploded_parts_match_the_reference(gpu: &mut Gpu) {
     let (data, cam) = grid_parts(gpu, Appearance::new(Mode::Dvr, presets::builtin("ct_skin_bone").unwrap()), (6, 5, 5));
     gpu.off.capture().unwrap();
     push_apart(gpu, data);
     matches_its_reference(gpu, "a_hundred_and_fifty_parts_apart", &cam, 151);
-    assert_eq!(packed_features(gpu) & UNIFORM_HEADERS, 0, "the regions' headers in storage");
+    assert_eq!(packed_features(gpu) & UNIFORM_REGIONS, 0, "the region records in storage");
     gpu.clear();
 }
 

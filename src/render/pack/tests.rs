@@ -212,7 +212,10 @@ fn packs_regions_planes_luts_and_the_atlas() {
     assert_eq!(packed.lut.len(), LUT_ATLAS_WIDTH as usize);
     assert_eq!(packed.regions[0].dims, glam::Vec4::new(16.0, 16.0, 16.0, 255.0));
     use crate::render::gpu_types::features as f;
-    assert_eq!(packed.features, f::PROJECTION | f::SHADING | f::MULTI_REGION | f::MIP_READS | f::UNIFORM_HEADERS | f::UNIFORM_REGIONS);
+    assert_eq!(
+        packed.features,
+        f::PROJECTION | f::SHADING | f::MULTI_REGION | f::MIP_READS | f::UNIFORM_PLANES | f::UNIFORM_REGIONS | f::UNIFORM_OCCUPANCY
+    );
     // Regions reading a mip chain: scalar samples of volumes in memory, not label codes,
     // not bricked volumes, not regions that draw nothing.
     let scalar = packed.regions[1];
@@ -478,8 +481,10 @@ fn a_part_record_is_its_regions_but_for_its_look() {
 }
 
 #[test]
-fn the_interval_loop_reads_headers_from_the_uniform_buffer_while_they_fit() {
-    use super::super::gpu_types::{GpuRegionHeader, MAX_HEADER_PLANES, MAX_HEADERS, features, headers_fit};
+fn the_records_planes_and_occupancy_ride_in_uniform_copies_while_they_fit() {
+    use super::super::gpu_types::{GpuRegion, MAX_UNIFORM_OCCUPANCY, MAX_UNIFORM_PLANES, MAX_UNIFORM_REGIONS, features};
+    use bevy::render::render_resource::ShaderType;
+    let copies = features::UNIFORM_REGIONS | features::UNIFORM_PLANES | features::UNIFORM_OCCUPANCY;
     let v = Arc::new(phantom::sphere(16, 5.0).unwrap());
     let tf = presets::builtin("grayscale_ramp").unwrap();
     let mut scene = RenderScene::single(v.clone(), Appearance::new(Mode::Dvr, tf));
@@ -487,36 +492,40 @@ fn the_interval_loop_reads_headers_from_the_uniform_buffer_while_they_fit() {
     let centre = (v.grid.world_bounds().0 + v.grid.world_bounds().1) * 0.5;
     scene.regions = vec![whole.clone().clipped(Plane::through(centre, Vec3::X)), whole.clipped(Plane::through(centre, -Vec3::X))];
     let packed = pack(&scene, 2048).unwrap();
-    assert_ne!(packed.features & features::UNIFORM_HEADERS, 0);
-    // A header holds what the loop reads of its record: the same planes, the same
-    // world step along any direction (to_native's fourth column does not act on one).
-    let mut r = packed.regions[1];
-    r.to_native.w_axis = glam::Vec4::new(5.0, -7.0, 3.0, 1.0);
-    r.bricked.x = 3;
-    r.projection.z = 2.0;
-    let h = GpuRegionHeader::of(&r);
-    assert_eq!((h.cluster, h.bounds), (r.cluster, r.bounds));
-    assert_eq!(h.planes.to_array(), [r.plane_offset, r.plane_count, r.hole_offset, r.hole_count]);
-    assert_eq!(h.kind.to_array(), [r.mode, r.flags, 3, 2]);
-    assert_eq!([h.native[0].w, h.native[1].w], [r.native_step, r.reference_length]);
-    for dir in [Vec3::X, Vec3::new(0.3, -0.8, 0.52).normalize()] {
-        let by_record = (r.to_native * dir.extend(0.0)).truncate();
-        let by_header = h.native[0].truncate() * dir.x + h.native[1].truncate() * dir.y + h.native[2].truncate() * dir.z;
-        assert!((by_record - by_header).length() <= 1e-6 * by_record.length(), "{by_record} {by_header}");
-    }
-    // The scene's uniform buffer holds them within the 64 KiB a uniform binding may
-    // hold on every device.
-    use bevy::render::render_resource::ShaderType;
-    let size = super::super::gpu_types::GpuSceneInfo::min_size().get();
-    assert!(size <= 65536 && size >= (MAX_HEADERS * 112 + MAX_HEADER_PLANES * 16) as u64, "{size}");
-    // The region records' uniform copy: every record of this scene, within 64 KiB.
-    use super::super::gpu_types::{GpuRegion, MAX_UNIFORM_REGIONS};
-    assert_ne!(packed.features & features::UNIFORM_REGIONS, 0);
+    assert_eq!(packed.features & copies, copies);
+    // The two halves (one volume, one look) share one run of occupancy bits: three sets
+    // of one bit per brick.
+    let (a, b) = (packed.regions[0], packed.regions[1]);
+    assert_ne!(a.flags & region_flags::OCCUPANCY, 0);
+    assert_eq!(a.occupancy_offset, b.occupancy_offset);
+    let bricks = (a.bricks.x * a.bricks.y * a.bricks.z) as usize;
+    assert_eq!(packed.occupancy.len(), 3 * bricks.div_ceil(32));
+    // Under another look (nothing visible: no brick occupied), each half has its own.
+    let mut looks = scene.clone();
+    let mut clear = presets::builtin("grayscale_ramp").unwrap();
+    clear.opacity.iter_mut().for_each(|p| p.1 = 0.0);
+    looks.appearances.push(Appearance::new(Mode::Dvr, clear));
+    looks.regions[1].appearance = 1;
+    let two = pack(&looks, 2048).unwrap();
+    assert_ne!(two.regions[0].occupancy_offset, two.regions[1].occupancy_offset);
+    assert_eq!(two.occupancy.len(), 6 * bricks.div_ceil(32));
+    assert_ne!(two.occupancy[..3 * bricks.div_ceil(32)], two.occupancy[3 * bricks.div_ceil(32)..]);
+    // Each copy holds 64 KiB at most, what a uniform binding may hold on every device;
+    // the records' is as many as fit.
     let record = GpuRegion::min_size().get();
     assert_eq!(record % 16, 0, "a record ends at a 16-byte boundary: one stride in both address spaces");
     assert!(record * MAX_UNIFORM_REGIONS as u64 <= 65536 && record * (MAX_UNIFORM_REGIONS as u64 + 1) > 65536, "{record}");
-    // Beyond the uniform buffer's room, the records in storage.
-    assert!(headers_fit(MAX_HEADERS as u32, MAX_HEADER_PLANES));
-    assert!(!headers_fit(MAX_HEADERS as u32 + 1, 6));
-    assert!(!headers_fit(2, MAX_HEADER_PLANES + 1));
+    assert_eq!((MAX_UNIFORM_PLANES * 16, MAX_UNIFORM_OCCUPANCY * 4), (65536, 65536));
+    // One past a copy's room, that buffer is read from storage; the others stay.
+    let mut big = packed.clone();
+    big.regions.resize(MAX_UNIFORM_REGIONS + 1, GpuRegion::default());
+    assert_eq!(super::uniform_copies(&big), copies & !features::UNIFORM_REGIONS);
+    let mut big = packed.clone();
+    big.planes.resize(MAX_UNIFORM_PLANES + 1, glam::Vec4::ZERO);
+    assert_eq!(super::uniform_copies(&big), copies & !features::UNIFORM_PLANES);
+    let mut big = packed.clone();
+    big.occupancy.resize(MAX_UNIFORM_OCCUPANCY + 1, 0);
+    assert_eq!(super::uniform_copies(&big), copies & !features::UNIFORM_OCCUPANCY);
+    big.occupancy.truncate(MAX_UNIFORM_OCCUPANCY);
+    assert_eq!(super::uniform_copies(&big), copies);
 }
