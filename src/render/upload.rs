@@ -15,7 +15,7 @@ use bevy::render::renderer::{RenderAdapter, RenderDevice, RenderQueue};
 use rayon::prelude::*;
 
 use super::extract::ExtractedScene;
-use super::gpu_types::{GpuSceneInfo, MAX_UNIFORM_OCCUPANCY, MAX_UNIFORM_PLANES, MAX_UNIFORM_REGIONS, features};
+use super::gpu_types::{GpuSceneInfo, MAX_UNIFORM_OCCUPANCY, MAX_UNIFORM_PLANES, MAX_UNIFORM_REGIONS};
 use super::pack::{LUT_ATLAS_WIDTH, MAX_INSETS, PackedScene, pack};
 use crate::region::RenderScene;
 use crate::volume::{Volume, Voxels};
@@ -81,29 +81,23 @@ pub struct UniformCopies {
 
 impl UniformCopies {
     fn of(device: &RenderDevice, packed: &PackedScene) -> Self {
-        let has = |feature: u32| packed.features & feature != 0;
         UniformCopies {
-            regions: uniform_copy(device, "focal regions (uniform)", &packed.regions, MAX_UNIFORM_REGIONS, has(features::UNIFORM_REGIONS)),
-            planes: uniform_copy(device, "focal planes (uniform)", &packed.planes, MAX_UNIFORM_PLANES, has(features::UNIFORM_PLANES)),
-            occupancy: uniform_copy(
-                device,
-                "focal occupancy (uniform)",
-                &packed.occupancy,
-                MAX_UNIFORM_OCCUPANCY,
-                has(features::UNIFORM_OCCUPANCY),
-            ),
+            regions: uniform_copy(device, "focal regions (uniform)", &packed.regions, MAX_UNIFORM_REGIONS),
+            planes: uniform_copy(device, "focal planes (uniform)", &packed.planes, MAX_UNIFORM_PLANES),
+            occupancy: uniform_copy(device, "focal occupancy (uniform)", &packed.occupancy, MAX_UNIFORM_OCCUPANCY),
         }
     }
 }
 
-/// A uniform buffer of `capacity` items, `items` first where `fits`, zeros after.
-fn uniform_copy<T>(device: &RenderDevice, label: &str, items: &[T], capacity: usize, fits: bool) -> Buffer
+/// A uniform buffer of `capacity` items: `items` first where they fit (the same test
+/// as the feature's, `render::pack::uniform_copies`), zeros after.
+fn uniform_copy<T>(device: &RenderDevice, label: &str, items: &[T], capacity: usize) -> Buffer
 where
     T: Copy + Default,
     Vec<T>: bevy::render::render_resource::ShaderType + bevy::render::render_resource::encase::internal::WriteInto,
 {
     let mut copy = vec![T::default(); capacity];
-    if fits && items.len() <= capacity {
+    if items.len() <= capacity {
         copy[..items.len()].copy_from_slice(items);
     }
     laid_out(device, label, &copy, BufferUsages::UNIFORM)
